@@ -1,0 +1,65 @@
+"""The rejects ledger: every input row is either used or counted here with a reason."""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+from enum import StrEnum
+
+
+class RejectReason(StrEnum):
+    UNPARSEABLE = "unparseable"
+    NO_POSITION = "position_not_available"
+    INVALID_MMSI = "invalid_mmsi"
+    NOT_A_VESSEL = "not_a_vessel"
+    DUPLICATE = "duplicate"
+    SPEED_JUMP = "speed_jump"
+    INCOMPLETE_MULTIPART = "incomplete_multipart"
+    UNSUPPORTED_MESSAGE = "unsupported_message_type"
+
+
+@dataclass
+class RejectsLedger:
+    """Counts of rows read, used and rejected (by reason), accumulated over a run.
+
+    ``rows_read == rows_used + rejected_total`` holds after every complete read.
+    """
+
+    rows_read: int = 0
+    rows_used: int = 0
+    rejects: Counter[str] = field(default_factory=Counter)
+    # Examples of rejected rows, for the manifest: reason -> a few "file:line: value" strings.
+    examples: dict[str, list[str]] = field(default_factory=dict)
+    max_examples: int = 5
+
+    def read(self, n: int = 1) -> None:
+        self.rows_read += n
+
+    def use(self, n: int = 1) -> None:
+        self.rows_used += n
+
+    def reject(self, reason: RejectReason, n: int = 1, example: str | None = None) -> None:
+        if n <= 0:
+            return
+        self.rejects[reason.value] += n
+        if example is not None:
+            bucket = self.examples.setdefault(reason.value, [])
+            if len(bucket) < self.max_examples:
+                bucket.append(example)
+
+    @property
+    def rejected_total(self) -> int:
+        return sum(self.rejects.values())
+
+    @property
+    def balanced(self) -> bool:
+        return self.rows_read == self.rows_used + self.rejected_total
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "rows_read": self.rows_read,
+            "rows_used": self.rows_used,
+            "rows_rejected": self.rejected_total,
+            "rejects_by_reason": dict(sorted(self.rejects.items())),
+            "reject_examples": self.examples,
+        }

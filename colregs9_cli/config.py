@@ -1,0 +1,103 @@
+"""Typed parameters: frozen dataclasses filled from TOML tables with strict key checking.
+
+Each core module owns its parameter dataclass (``ManoeuvrabilityParams`` in
+``manoeuvrability.py``, ``ColregsParams`` in ``colregs.py``, ...). This module turns a TOML
+table into one of them, rejecting unknown keys and wrong types with a message that names the
+file, the table and the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+import types
+import typing
+from pathlib import Path
+from typing import Any, TypeVar
+
+from .errors import InputFileError, QueryError
+
+T = TypeVar("T")
+
+
+def read_toml(path: Path) -> dict[str, Any]:
+    """Read a TOML file; a missing file or a syntax error becomes one clear error."""
+    if not path.is_file():
+        raise InputFileError(f"{path}: no such file; check the path")
+    try:
+        with path.open("rb") as handle:
+            return tomllib.load(handle)
+    except tomllib.TOMLDecodeError as exc:
+        raise QueryError(f"{path}: TOML syntax error: {exc}; fix the file") from None
+    except UnicodeDecodeError as exc:
+        raise QueryError(f"{path}: not UTF-8 text ({exc.reason}); save it as UTF-8") from None
+
+
+def _accepts(annotation: Any, value: Any) -> bool:
+    origin = typing.get_origin(annotation)
+    if annotation is typing.Any:
+        return True
+    if origin in (typing.Union, types.UnionType):
+        return any(_accepts(arg, value) for arg in typing.get_args(annotation))
+    if origin is typing.Literal:
+        return value in typing.get_args(annotation)
+    if annotation is type(None):
+        return value is None
+    if annotation is float:
+        return isinstance(value, int | float) and not isinstance(value, bool)
+    if annotation is int:
+        return isinstance(value, int) and not isinstance(value, bool)
+    if origin in (tuple, list, frozenset, set):
+        return isinstance(value, list | tuple)
+    if isinstance(annotation, type) and issubclass(annotation, dataclasses.Field):
+        return True
+    if isinstance(annotation, type):
+        if hasattr(annotation, "__members__"):  # an Enum: accept its values
+            return value in {m.value for m in annotation}  # type: ignore[attr-defined]
+        return isinstance(value, annotation)
+    return True
+
+
+def _convert(annotation: Any, value: Any) -> Any:
+    origin = typing.get_origin(annotation)
+    if origin in (typing.Union, types.UnionType):
+        for arg in typing.get_args(annotation):
+            if arg is not type(None) and _accepts(arg, value):
+                return _convert(arg, value)
+        return value
+    if annotation is float:
+        return float(value)
+    if origin is tuple:
+        return tuple(value)
+    if origin is frozenset:
+        return frozenset(value)
+    if isinstance(annotation, type) and hasattr(annotation, "__members__"):
+        return annotation(value)
+    return value
+
+
+def dataclass_from_table(cls: type[T], table: dict[str, Any], where: str) -> T:
+    """Build the frozen dataclass ``cls`` from a TOML table, defaults for absent keys.
+
+    ``where`` names the place for messages, e.g. ``"queries/q.toml [manoeuvrability]"``.
+    Validation of ranges stays in the dataclass's own ``__post_init__``.
+    """
+    if not isinstance(table, dict):
+        raise QueryError(f"{where}: expected a table, got {table!r}")
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
+    unknown = sorted(set(table) - set(fields))
+    if unknown:
+        raise QueryError(
+            f"{where}: unknown key {unknown[0]!r}; allowed keys are {', '.join(sorted(fields))}"
+        )
+    values: dict[str, Any] = {}
+    for name, value in table.items():
+        annotation = hints[name]
+        if not _accepts(annotation, value):
+            raise QueryError(
+                f"{where}: key {name!r} has value {value!r}, which is not a valid "
+                f"{getattr(annotation, '__name__', annotation)}"
+            )
+        values[name] = _convert(annotation, value)
+    return cls(**values)

@@ -1,0 +1,42 @@
+"""The error hierarchy. The CLI prints ``Error: <message>`` and exits with ``exit_code``.
+
+Messages name the file, line or column, the bad value, and what to do about it.
+"""
+
+from __future__ import annotations
+
+
+class Colregs9Error(Exception):
+    """Base class for every error caused by the user's input or environment."""
+
+    exit_code = 1
+
+
+class InputFileError(Colregs9Error):
+    """An input file is missing, empty, truncated, undecodable or of an unknown layout."""
+
+    exit_code = 2
+
+
+class QueryError(Colregs9Error):
+    """A query or scenario TOML file is malformed or has invalid values."""
+
+    exit_code = 2
+
+
+class ParameterError(Colregs9Error):
+    """A parameter (from the CLI or a TOML table) is out of range."""
+
+    exit_code = 2
+
+
+class ChartError(Colregs9Error):
+    """A chart cannot be read or holds no usable depth information."""
+
+    exit_code = 2
+
+
+class NoDataError(Colregs9Error):
+    """The input is valid but the query selects nothing to work on."""
+
+    exit_code = 3

@@ -1,0 +1,60 @@
+"""Progress bars on stderr: shown only for a TTY and when not ``--quiet``."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import Protocol
+
+from rich.console import Console
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TextColumn,
+    TimeElapsedColumn,
+    TimeRemainingColumn,
+)
+
+
+class ProgressSink(Protocol):
+    def advance(self, amount: float = 1.0) -> None: ...
+
+
+class _Silent:
+    def advance(self, amount: float = 1.0) -> None:
+        return None
+
+
+class _RichSink:
+    def __init__(self, progress: Progress, task_id: int) -> None:
+        self._progress = progress
+        self._task_id = task_id
+
+    def advance(self, amount: float = 1.0) -> None:
+        self._progress.advance(self._task_id, amount)  # type: ignore[arg-type]
+
+
+def progress_enabled(quiet: bool) -> bool:
+    return not quiet and sys.stderr.isatty()
+
+
+@contextmanager
+def progress_bar(description: str, total: float | None, enabled: bool) -> Iterator[ProgressSink]:
+    """A progress bar over ``total`` units (bytes, steps, ...), or a silent sink."""
+    if not enabled:
+        yield _Silent()
+        return
+    progress = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=True,
+    )
+    with progress:
+        task_id = progress.add_task(description, total=total)
+        yield _RichSink(progress, task_id)

@@ -1,0 +1,1 @@
+"""Report writers: CSV, PNG (matplotlib, Agg), Markdown and JSON, all written atomically."""
