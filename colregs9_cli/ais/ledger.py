@@ -20,13 +20,16 @@ class RejectReason(StrEnum):
 
 @dataclass
 class RejectsLedger:
-    """Counts of rows read, used and rejected (by reason), accumulated over a run.
+    """Counts of rows read, used, left out by the query, and rejected (by reason).
 
-    ``rows_read == rows_used + rejected_total`` holds after every complete read.
+    ``rows_read == rows_used + rows_outside_query + rejected_total`` holds after every
+    complete read. Rows outside the query are valid input that the query does not select;
+    they are not rejects, but they are counted so that nothing disappears unaccounted.
     """
 
     rows_read: int = 0
     rows_used: int = 0
+    rows_outside_query: int = 0
     rejects: Counter[str] = field(default_factory=Counter)
     # Examples of rejected rows, for the manifest: reason -> a few "file:line: value" strings.
     examples: dict[str, list[str]] = field(default_factory=dict)
@@ -37,6 +40,9 @@ class RejectsLedger:
 
     def use(self, n: int = 1) -> None:
         self.rows_used += n
+
+    def outside_query(self, n: int = 1) -> None:
+        self.rows_outside_query += n
 
     def reject(self, reason: RejectReason, n: int = 1, example: str | None = None) -> None:
         if n <= 0:
@@ -53,12 +59,13 @@ class RejectsLedger:
 
     @property
     def balanced(self) -> bool:
-        return self.rows_read == self.rows_used + self.rejected_total
+        return self.rows_read == self.rows_used + self.rows_outside_query + self.rejected_total
 
     def to_dict(self) -> dict[str, object]:
         return {
             "rows_read": self.rows_read,
             "rows_used": self.rows_used,
+            "rows_outside_query": self.rows_outside_query,
             "rows_rejected": self.rejected_total,
             "rejects_by_reason": dict(sorted(self.rejects.items())),
             "reject_examples": self.examples,
