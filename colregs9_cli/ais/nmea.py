@@ -1,0 +1,635 @@
+"""Raw NMEA AIS logs (``!AIVDM``/``!BSVDM``/...), decoded with pyais, in the canonical schema.
+
+Timestamps. A message takes its time from, in this order: a tag block with ``c:`` on the
+sentence's line (``\\s:rORBCOMM,c:1384257600*hh\\!AIVDM,...``), a trailing ``,<unix time>``
+after the checksum, or a pending time set by the line before: DMA's
+``$PGHP,1,Y,M,D,h,m,s,ms,...`` or a stand-alone tag block line with ``c:``. Any sentence
+line (AIS or not) consumes the pending time, because ``$PGHP`` stamps exactly the next
+sentence. A tag block whose checksum fails gives no time. ``c:`` values above 1e11 are taken
+as milliseconds. Times are floored to the second (the schema is ``timestamp[s, UTC]``). A
+message with no time from any of these is rejected as unparseable: without a time it cannot
+be placed in a track.
+
+Multi-sentence messages are reassembled per (sentence tag, channel, sequential id, fragment
+count), so interleaved messages on other channels or ids do not disturb each other. A group
+must arrive in order 1, 2, ..., n; a gap or a repeat marks the group broken, and a broken or
+unfinished group counts once as ``incomplete_multipart``. Accepting fragments out of order
+would let the tail of an older message complete a newer one with the same recycled id (0-9),
+which decodes into a plausible but wrong message. The message takes the time of its first
+timed fragment and the line number of its first fragment. A sentence that fails its checksum
+is one unparseable row by itself (its fragment header cannot be trusted), so the rest of its
+message then counts as incomplete.
+
+Accounting. A row is one AIS message after reassembly, and each becomes exactly one output
+row or one reject: positions (1, 2, 3, 18, 19, 27), statics (5, 24), ``not_a_vessel`` (4, 9,
+11, 21), ``unsupported_message_type`` (other defined types) or ``unparseable`` (bad
+checksum, malformed, a payload too short for the fields read, a type outside 1-27, no time).
+Other NMEA sentences (``$PSTT``, ``$GPRMC``, ...) and tag-block lines are not AIS messages
+and are not rows; any other non-blank line is an unparseable row. Invalid MMSIs and missing
+positions are left to the pipeline, which counts them.
+
+Static join. Positions get ship type, dimensions, draught, name, call sign and IMO from the
+static reports of the same MMSI (types 5, 24 and the static part of 19), field by field, from
+the report nearest in time that has that field. Nearest rather than latest: over a long log
+the draught changes between voyages, and the nearest report is the one that was in force; a
+per-field choice because type 24 part A carries only the name and part B only the rest, so
+the nearest whole report would often have the field empty. A position's own values (type 19)
+win over joined ones. The join needs every static, which may come after the position, so the
+whole input is collected and yielded as one batch: fine for logs of a few million lines (peak
+about 1 kB per message while decoding, measured on the DMA fixture), not for months of raw
+feed — split those by day.
+
+Not available -> null: lat outside ±90 (91), lon outside ±180 (181), SOG 102.3 (type 27: 63),
+COG and heading 360 and above (360, 511; type 27: 511), rate of turn -128 and ±127 (turning
+fast with no turn indicator: no rate is known), dimension 0, draught 0, ship type 0, IMO 0,
+empty text. The rate of turn is (raw / 4.733)² deg/min with the sign of raw. Type 27 (the
+long-range broadcast of SOLAS ships) is "Class A".
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, field
+from datetime import UTC
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+from pyais.exceptions import AISBaseException
+from pyais.messages import (
+    AISSentence,
+    GatehouseSentence,
+    MessageType1,
+    MessageType5,
+    MessageType18,
+    MessageType19,
+    MessageType24PartA,
+    MessageType24PartB,
+    MessageType27,
+    NMEASentenceFactory,
+    Payload,
+    TagBlock,
+)
+
+from .batch import STATIC_SCHEMA, AisBatch
+from .ledger import RejectReason, RejectsLedger
+from .schema import CANONICAL_SCHEMA
+
+# Numeric AIS ship type (ITU-R M.1371 table 53) -> the DMA "Ship type" text. 0 ("not
+# available") is absent on purpose: it becomes null, like DMA's "Undefined".
+SHIP_TYPE_CATEGORIES: dict[int, str] = {
+    **dict.fromkeys(range(1, 20), "Reserved"),
+    **dict.fromkeys(range(20, 30), "WIG"),
+    30: "Fishing",
+    31: "Towing",
+    32: "Towing long/wide",
+    33: "Dredging",
+    34: "Diving",
+    35: "Military",
+    36: "Sailing",
+    37: "Pleasure",
+    38: "Reserved",
+    39: "Reserved",
+    **dict.fromkeys(range(40, 50), "HSC"),
+    50: "Pilot",
+    51: "SAR",
+    52: "Tug",
+    53: "Port tender",
+    54: "Anti-pollution",
+    55: "Law enforcement",
+    56: "Spare 1",
+    57: "Spare 2",
+    58: "Medical",
+    59: "Not party to conflict",
+    **dict.fromkeys(range(60, 70), "Passenger"),
+    **dict.fromkeys(range(70, 80), "Cargo"),
+    **dict.fromkeys(range(80, 90), "Tanker"),
+    **dict.fromkeys(range(90, 100), "Other"),
+}
+
+POSITION_TYPES = frozenset({1, 2, 3, 18, 19, 27})
+STATIC_TYPES = frozenset({5, 24})
+NOT_A_VESSEL_TYPES = frozenset({4, 9, 11, 21})  # base station, SAR aircraft, UTC reply, AtoN
+_CLASS_B_TYPES = frozenset({18, 19})
+# Type 27 is the long-range broadcast of SOLAS (Class A) ships.
+_MOBILE_TYPE = {t: "Class B" if t in _CLASS_B_TYPES else "Class A" for t in POSITION_TYPES}
+
+_EXAMPLE_CHARS = 160
+_MAX_UNIX_S = 4_102_444_800  # 2100-01-01: larger values are not plausible receive times
+_UNIX_MS_THRESHOLD = 1e11  # above this a c: value is milliseconds
+
+
+def _bits_through(cls: type[Payload], last_field: str) -> int:
+    """Payload bits needed to hold every field of ``cls`` up to and including ``last_field``."""
+    total = 0
+    for attribute in cls.fields():
+        total += attribute.metadata["width"]
+        if attribute.name == last_field:
+            return total
+    raise ValueError(f"{cls.__name__} has no field {last_field}")
+
+
+def _required_bits() -> dict[int, int]:
+    # pyais decodes a truncated field from the bits it has, so a short payload gives a wrong
+    # MMSI or position instead of None; we require every bit of the fields we read.
+    type1 = _bits_through(MessageType1, "heading")
+    return {
+        1: type1,
+        2: type1,
+        3: type1,
+        18: _bits_through(MessageType18, "heading"),
+        19: _bits_through(MessageType19, "to_starboard"),
+        27: _bits_through(MessageType27, "course"),
+        5: _bits_through(MessageType5, "draught"),
+        24: _bits_through(MessageType24PartA, "shipname"),
+    }
+
+
+_REQUIRED_BITS = _required_bits()
+_TYPE24_PART_B_BITS = _bits_through(MessageType24PartB, "to_starboard")
+_ROT_OFFSET_BITS = _bits_through(MessageType1, "status")  # the 8-bit turn field follows
+
+
+@dataclass
+class _Fragments:
+    """An open multi-sentence group."""
+
+    sentences: list[AISSentence]
+    line_no: int
+    timestamp: int | None
+    raw: list[str]
+    broken: bool = False
+
+    def add(self, sentence: AISSentence, timestamp: int | None, raw: str) -> None:
+        if sentence.frag_num != len(self.sentences) + 1:
+            self.broken = True
+        self.sentences.append(sentence)
+        self.raw.append(raw)
+        if self.timestamp is None:
+            self.timestamp = timestamp
+
+
+@dataclass
+class _Columns:
+    """Decoded values as plain lists; sentinels are nulled later, on whole arrays."""
+
+    timestamp: list[int] = field(default_factory=list)
+    mmsi: list[int] = field(default_factory=list)
+    msg_type: list[int] = field(default_factory=list)
+    lat: list[float | None] = field(default_factory=list)
+    lon: list[float | None] = field(default_factory=list)
+    sog: list[float | None] = field(default_factory=list)
+    cog: list[float | None] = field(default_factory=list)
+    heading: list[float | None] = field(default_factory=list)
+    rot_raw: list[float | None] = field(default_factory=list)
+    nav_status: list[float | None] = field(default_factory=list)
+    ship_type: list[float | None] = field(default_factory=list)
+    to_bow: list[float | None] = field(default_factory=list)
+    to_stern: list[float | None] = field(default_factory=list)
+    to_port: list[float | None] = field(default_factory=list)
+    to_starboard: list[float | None] = field(default_factory=list)
+    draught: list[float | None] = field(default_factory=list)
+    name: list[str | None] = field(default_factory=list)
+    callsign: list[str | None] = field(default_factory=list)
+    imo: list[float | None] = field(default_factory=list)
+
+
+_STATIC_ONLY = (
+    "ship_type",
+    "to_bow",
+    "to_stern",
+    "to_port",
+    "to_starboard",
+    "draught",
+    "name",
+    "callsign",
+    "imo",
+)
+
+
+class _NmeaReader:
+    def __init__(self, source_name: str, ledger: RejectsLedger) -> None:
+        self.source_name = source_name
+        self.ledger = ledger
+        self.pending_timestamp: int | None = None
+        self.open_groups: dict[tuple[str, str, int | None, int], _Fragments] = {}
+        self.positions = _Columns()
+        self.statics = _Columns()
+
+    # -- lines ------------------------------------------------------------------------------
+
+    def feed(self, line_no: int, line: str) -> None:
+        text = line.strip()
+        if not text:
+            return
+        line_timestamp: int | None = None
+        if text[0] == "\\":
+            end = text.find("\\", 1)
+            if end < 0:
+                self._unparseable(line_no, "tag block without closing backslash", text)
+                return
+            line_timestamp = self._tag_block_time(text[1:end])
+            text = text[end + 1 :].strip()
+            if not text:
+                if line_timestamp is not None:
+                    self.pending_timestamp = line_timestamp
+                return
+        if text[0] == "$":
+            self._other_sentence(text)
+            return
+        if text[0] != "!":
+            self._unparseable(line_no, "not an NMEA sentence", line.strip())
+            return
+        if text[3:6].upper() not in ("VDM", "VDO"):
+            self.pending_timestamp = None
+            return
+        sentence_text, suffix_timestamp = _split_time_suffix(text)
+        timestamp = line_timestamp if line_timestamp is not None else suffix_timestamp
+        if timestamp is None:
+            timestamp = self.pending_timestamp
+        self.pending_timestamp = None
+        self._ais_sentence(line_no, sentence_text, timestamp)
+
+    def _tag_block_time(self, tag_block: str) -> int | None:
+        if "c:" not in tag_block:
+            return None
+        try:
+            block = TagBlock(tag_block.encode("ascii"))
+            block.init()
+        except (UnicodeEncodeError, AISBaseException, ValueError, IndexError):
+            return None
+        if not block.is_valid:
+            return None
+        return _unix_seconds(block.receiver_timestamp)
+
+    def _other_sentence(self, text: str) -> None:
+        self.pending_timestamp = None
+        if text[:6].upper() != "$PGHP,":
+            return
+        try:
+            sentence = NMEASentenceFactory.produce(text.encode("ascii"))
+        except (UnicodeEncodeError, AISBaseException, ValueError):
+            return
+        if isinstance(sentence, GatehouseSentence) and sentence.is_valid:
+            self.pending_timestamp = math.floor(sentence.timestamp.replace(tzinfo=UTC).timestamp())
+
+    def _ais_sentence(self, line_no: int, text: str, timestamp: int | None) -> None:
+        try:
+            sentence = NMEASentenceFactory.produce(text.encode("ascii"))
+        except (UnicodeEncodeError, AISBaseException, ValueError) as err:
+            self._unparseable(line_no, f"malformed sentence ({err})", text)
+            return
+        if not isinstance(sentence, AISSentence):
+            self._unparseable(line_no, "malformed sentence", text)
+            return
+        if not sentence.is_valid:
+            self._unparseable(line_no, "checksum does not match", text)
+            return
+        if sentence.frag_cnt == 1:
+            self._message(sentence, line_no, timestamp, text)
+            return
+        key = (text[1:6].upper(), sentence.channel, sentence.seq_id, sentence.frag_cnt)
+        group = self.open_groups.get(key)
+        if sentence.frag_num == 1 or group is None:
+            if group is not None:
+                self._incomplete(group)
+            group = _Fragments([sentence], line_no, timestamp, [text], sentence.frag_num != 1)
+            self.open_groups[key] = group
+        else:
+            group.add(sentence, timestamp, text)
+        if sentence.frag_num == sentence.frag_cnt:
+            del self.open_groups[key]
+            if group.broken:
+                self._incomplete(group)
+            else:
+                whole = AISSentence.assemble_from_iterable(group.sentences)
+                self._message(whole, group.line_no, group.timestamp, " ".join(group.raw))
+
+    def finish(self) -> None:
+        for group in self.open_groups.values():
+            self._incomplete(group)
+        self.open_groups.clear()
+
+    # -- messages ---------------------------------------------------------------------------
+
+    def _message(
+        self, sentence: AISSentence, line_no: int, timestamp: int | None, raw: str
+    ) -> None:
+        self.ledger.read()
+        msg_type = sentence.ais_id
+        if timestamp is None:
+            self._reject_message(
+                RejectReason.UNPARSEABLE,
+                line_no,
+                "no time (no $PGHP line before it, no tag block c:, no trailing unix time)",
+                raw,
+            )
+            return
+        if not sentence.payload:
+            self._reject_message(RejectReason.UNPARSEABLE, line_no, "empty payload", raw)
+            return
+        if msg_type in NOT_A_VESSEL_TYPES:
+            self._reject_message(
+                RejectReason.NOT_A_VESSEL, line_no, f"message type {msg_type}", raw
+            )
+            return
+        if not 1 <= msg_type <= 27:
+            self._reject_message(
+                RejectReason.UNPARSEABLE, line_no, f"no AIS message type {msg_type}", raw
+            )
+            return
+        if msg_type not in POSITION_TYPES and msg_type not in STATIC_TYPES:
+            self._reject_message(
+                RejectReason.UNSUPPORTED_MESSAGE, line_no, f"message type {msg_type}", raw
+            )
+            return
+        n_bits = len(sentence.bv)
+        if n_bits < _REQUIRED_BITS[msg_type]:
+            self._reject_message(
+                RejectReason.UNPARSEABLE,
+                line_no,
+                f"type {msg_type} payload has {n_bits} bits, needs {_REQUIRED_BITS[msg_type]}",
+                raw,
+            )
+            return
+        try:
+            decoded = sentence.decode()
+        except (AISBaseException, ValueError) as err:
+            self._reject_message(RejectReason.UNPARSEABLE, line_no, f"undecodable ({err})", raw)
+            return
+        if msg_type == 24 and decoded.partno not in (0, 1):
+            self._reject_message(
+                RejectReason.UNPARSEABLE, line_no, f"type 24 part number {decoded.partno}", raw
+            )
+            return
+        if msg_type == 24 and decoded.partno == 1 and n_bits < _TYPE24_PART_B_BITS:
+            self._reject_message(
+                RejectReason.UNPARSEABLE,
+                line_no,
+                f"type 24 part B payload has {n_bits} bits, needs {_TYPE24_PART_B_BITS}",
+                raw,
+            )
+            return
+        if msg_type in POSITION_TYPES:
+            self._add_position(decoded, sentence, msg_type, timestamp)
+        else:
+            _append_static(self.statics, decoded, msg_type, timestamp)
+
+    def _add_position(
+        self, decoded: Payload, sentence: AISSentence, msg_type: int, timestamp: int
+    ) -> None:
+        columns = self.positions
+        columns.timestamp.append(timestamp)
+        columns.mmsi.append(decoded.mmsi)
+        columns.msg_type.append(msg_type)
+        columns.lat.append(decoded.lat)
+        columns.lon.append(decoded.lon)
+        columns.sog.append(decoded.speed)
+        columns.cog.append(decoded.course)
+        columns.heading.append(getattr(decoded, "heading", None))
+        status = getattr(decoded, "status", None)
+        columns.nav_status.append(None if status is None else int(status))
+        # pyais rounds the rate of turn to whole degrees per minute (raw 1-2 become 0), so we
+        # read the raw field through pyais's bit vector and convert it in _positions_table.
+        columns.rot_raw.append(
+            sentence.bv.get_signed(_ROT_OFFSET_BITS, 8) if msg_type <= 3 else None
+        )
+        if msg_type == 19:
+            _append_static_fields(columns, decoded)
+        else:
+            for name in _STATIC_ONLY:
+                getattr(columns, name).append(None)
+
+    # -- rejects ----------------------------------------------------------------------------
+
+    def _example(self, line_no: int, why: str, raw: str) -> str:
+        shown = raw if len(raw) <= _EXAMPLE_CHARS else raw[:_EXAMPLE_CHARS] + "..."
+        return f"{self.source_name}:{line_no}: {why}: {shown}"
+
+    def _reject_message(self, reason: RejectReason, line_no: int, why: str, raw: str) -> None:
+        self.ledger.reject(reason, example=self._example(line_no, why, raw))
+
+    def _unparseable(self, line_no: int, why: str, raw: str) -> None:
+        self.ledger.read()
+        self._reject_message(RejectReason.UNPARSEABLE, line_no, why, raw)
+
+    def _incomplete(self, group: _Fragments) -> None:
+        self.ledger.read()
+        have = ",".join(str(s.frag_num) for s in group.sentences)
+        self._reject_message(
+            RejectReason.INCOMPLETE_MULTIPART,
+            group.line_no,
+            f"fragments {have} of {group.sentences[0].frag_cnt}",
+            " ".join(group.raw),
+        )
+
+
+def _append_static_fields(columns: _Columns, decoded: Payload) -> None:
+    ship_type = getattr(decoded, "ship_type", None)
+    columns.ship_type.append(None if ship_type is None else int(ship_type))
+    for name in ("to_bow", "to_stern", "to_port", "to_starboard"):
+        getattr(columns, name).append(getattr(decoded, name, None))
+    columns.draught.append(getattr(decoded, "draught", None))
+    columns.name.append(getattr(decoded, "shipname", None))
+    columns.callsign.append(getattr(decoded, "callsign", None))
+    columns.imo.append(getattr(decoded, "imo", None))
+
+
+def _append_static(columns: _Columns, decoded: Payload, msg_type: int, timestamp: int) -> None:
+    columns.timestamp.append(timestamp)
+    columns.mmsi.append(decoded.mmsi)
+    columns.msg_type.append(msg_type)
+    _append_static_fields(columns, decoded)
+
+
+def _split_time_suffix(text: str) -> tuple[str, int | None]:
+    """``!AIVDM,...,0*5C,1384257600`` -> (the sentence, 1384257600)."""
+    star = text.rfind("*")
+    if star < 0 or len(text) <= star + 3 or text[star + 3] != ",":
+        return text, None
+    return text[: star + 3], _unix_seconds(text[star + 4 :].rsplit(",", 1)[-1])
+
+
+def _unix_seconds(value: str | None) -> int | None:
+    if not value:
+        return None
+    try:
+        seconds = float(value)
+    except ValueError:
+        return None
+    if seconds > _UNIX_MS_THRESHOLD:
+        seconds /= 1000.0
+    if not 0 < seconds < _MAX_UNIX_S:
+        return None
+    return math.floor(seconds)
+
+
+# -- tables ---------------------------------------------------------------------------------
+
+
+def _floats(values: list[float | None]) -> np.ndarray:
+    return np.array(values, dtype=np.float64)
+
+
+def _null_where(values: np.ndarray, not_available: np.ndarray) -> np.ndarray:
+    return np.where(not_available, np.nan, values)
+
+
+def _dimension(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """A+B (or C+D) only when both parts are reported; 0 means "not available"."""
+    return np.where((first > 0) & (second > 0), first + second, np.nan)
+
+
+def _text(values: list[str | None]) -> pd.Series:
+    series = pd.Series(values, dtype=object)
+    return series.where(series.notna() & (series != "") & (series != "Unknown"), None)
+
+
+def _static_frame(columns: _Columns) -> pd.DataFrame:
+    """Static fields of ``columns`` with sentinels as nulls; ship_type stays numeric here."""
+    ship_type = _floats(columns.ship_type)
+    draught = _floats(columns.draught)
+    imo = _floats(columns.imo)
+    return pd.DataFrame(
+        {
+            "timestamp": np.array(columns.timestamp, dtype=np.int64),
+            "mmsi": np.array(columns.mmsi, dtype=np.int64),
+            "ship_type": _null_where(ship_type, ~(ship_type > 0)),
+            "length_m": _dimension(_floats(columns.to_bow), _floats(columns.to_stern)),
+            "breadth_m": _dimension(_floats(columns.to_port), _floats(columns.to_starboard)),
+            "draught_m": _null_where(draught, ~(draught > 0)),
+            "name": _text(columns.name),
+            "callsign": _text(columns.callsign),
+            "imo": _null_where(imo, ~(imo > 0)),
+        }
+    )
+
+
+_JOINED_FIELDS = ("ship_type", "length_m", "breadth_m", "draught_m", "name", "callsign", "imo")
+
+
+def _join_statics(positions: pd.DataFrame, statics: pd.DataFrame) -> pd.DataFrame:
+    """Fill each static field of ``positions`` from the nearest-in-time report that has it."""
+    if positions.empty or statics.empty:
+        return positions
+    ordered = positions.reset_index(names="_row").sort_values("timestamp", kind="stable")
+    for name in _JOINED_FIELDS:
+        source = statics.loc[statics[name].notna(), ["timestamp", "mmsi", name]]
+        if source.empty:
+            continue
+        nearest = pd.merge_asof(
+            ordered[["_row", "timestamp", "mmsi"]],
+            source.sort_values("timestamp", kind="stable").rename(columns={name: "_joined"}),
+            on="timestamp",
+            by="mmsi",
+            direction="nearest",
+        )
+        ordered[name] = ordered[name].where(ordered[name].notna(), nearest["_joined"].to_numpy())
+    return ordered.sort_values("_row").drop(columns="_row").reset_index(drop=True)
+
+
+def _ship_type_text(codes: pd.Series) -> pa.Array:
+    text = codes.map(lambda code: SHIP_TYPE_CATEGORIES.get(int(code)), na_action="ignore")
+    return pa.array(text.where(text.notna(), None), type=pa.string())
+
+
+def _timestamps(seconds: pd.Series) -> pa.Array:
+    return pa.array(seconds.to_numpy(dtype=np.int64), type=pa.timestamp("s", tz="UTC"))
+
+
+def _optional(values: pd.Series | np.ndarray, dtype: pa.DataType) -> pa.Array:
+    return pa.array(values, type=dtype, from_pandas=True)
+
+
+def _positions_table(
+    columns: _Columns, own_static: pd.DataFrame, statics: pd.DataFrame
+) -> pa.Table:
+    long_range = np.array(columns.msg_type, dtype=np.int64) == 27
+    lat = _floats(columns.lat)
+    lon = _floats(columns.lon)
+    sog = _floats(columns.sog)
+    cog = _floats(columns.cog)
+    heading = _floats(columns.heading)
+    rot_raw = _floats(columns.rot_raw)
+    # ±127 is "turning faster than 5°/30 s, no turn indicator": no rate is known.
+    rot_known = np.abs(rot_raw) <= 126
+    rot = np.where(rot_known, np.sign(rot_raw) * (rot_raw / 4.733) ** 2, np.nan)
+    positions = pd.DataFrame(
+        {
+            "timestamp": own_static["timestamp"],
+            "mmsi": own_static["mmsi"],
+            "lat_deg": _null_where(lat, ~(np.abs(lat) <= 90)),
+            "lon_deg": _null_where(lon, ~(np.abs(lon) <= 180)),
+            # Type 27 sends whole knots and degrees, with 63 and 511 as "not available".
+            "sog_kn": _null_where(sog, ~np.where(long_range, sog < 63, sog < 102.3)),
+            "cog_deg": _null_where(cog, ~(cog < 360)),
+            "heading_deg": _null_where(heading, ~(heading < 360)),
+            "rot_deg_per_min": rot,
+            "nav_status": _floats(columns.nav_status),
+            **own_static.drop(columns=["timestamp", "mmsi"]),
+        }
+    )
+    positions = _join_statics(positions, statics)
+    mobile_type = [_MOBILE_TYPE[t] for t in columns.msg_type]
+    return pa.table(
+        {
+            "timestamp": _timestamps(positions["timestamp"]),
+            "mmsi": pa.array(positions["mmsi"], type=pa.int64()),
+            "lat_deg": _optional(positions["lat_deg"], pa.float64()),
+            "lon_deg": _optional(positions["lon_deg"], pa.float64()),
+            "sog_kn": _optional(positions["sog_kn"], pa.float64()),
+            "cog_deg": _optional(positions["cog_deg"], pa.float64()),
+            "heading_deg": _optional(positions["heading_deg"], pa.float64()),
+            "rot_deg_per_min": _optional(positions["rot_deg_per_min"], pa.float64()),
+            "nav_status": _optional(positions["nav_status"], pa.int8()),
+            "ship_type": _ship_type_text(positions["ship_type"]),
+            "mobile_type": pa.array(mobile_type, type=pa.string()),
+            "length_m": _optional(positions["length_m"], pa.float64()),
+            "breadth_m": _optional(positions["breadth_m"], pa.float64()),
+            "draught_m": _optional(positions["draught_m"], pa.float64()),
+            "name": _optional(positions["name"], pa.string()),
+            "callsign": _optional(positions["callsign"], pa.string()),
+            "imo": _optional(positions["imo"], pa.int64()),
+        },
+        schema=CANONICAL_SCHEMA,
+    )
+
+
+def _statics_table(statics: pd.DataFrame) -> pa.Table:
+    return pa.table(
+        {
+            "timestamp": _timestamps(statics["timestamp"]),
+            "mmsi": pa.array(statics["mmsi"], type=pa.int64()),
+            "ship_type": _ship_type_text(statics["ship_type"]),
+            "length_m": _optional(statics["length_m"], pa.float64()),
+            "breadth_m": _optional(statics["breadth_m"], pa.float64()),
+            "draught_m": _optional(statics["draught_m"], pa.float64()),
+            "name": _optional(statics["name"], pa.string()),
+            "callsign": _optional(statics["callsign"], pa.string()),
+            "imo": _optional(statics["imo"], pa.int64()),
+        },
+        schema=STATIC_SCHEMA,
+    )
+
+
+def read_nmea(lines: Iterable[str], source_name: str, ledger: RejectsLedger) -> Iterator[AisBatch]:
+    """Decode a raw NMEA AIS log into one batch of positions and static reports.
+
+    ``lines`` are the log's text lines; ``source_name`` names the file in reject examples
+    ("file:line: why: sentence"). Every AIS message is counted with ``ledger.read()`` and
+    becomes one output row or one reject (see the module docstring for the rules).
+    """
+    reader = _NmeaReader(source_name, ledger)
+    for line_no, line in enumerate(lines, start=1):
+        reader.feed(line_no, line)
+    reader.finish()
+    statics = _static_frame(reader.statics)
+    # Type 19 positions carry static fields too; they fill other positions of that vessel.
+    position_statics = _static_frame(reader.positions)
+    is_type19 = np.array(reader.positions.msg_type, dtype=np.int64) == 19
+    join_source = pd.concat([statics, position_statics[is_type19]], ignore_index=True)
+    yield AisBatch(
+        positions=_positions_table(reader.positions, position_statics, join_source),
+        statics=_statics_table(statics),
+    )

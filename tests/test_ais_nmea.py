@@ -1,0 +1,557 @@
+"""The raw NMEA reader: input forms, reassembly, sentinels, accounting and the static join."""
+
+from __future__ import annotations
+
+import gzip
+from collections.abc import Iterator
+from datetime import UTC, datetime
+from functools import reduce
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from pyais import encode_dict
+
+from colregs9_cli.ais.batch import AisBatch
+from colregs9_cli.ais.ledger import RejectReason, RejectsLedger
+from colregs9_cli.ais.nmea import SHIP_TYPE_CATEGORIES, read_nmea
+from colregs9_cli.errors import InputFileError
+
+NOON = 1_384_257_600  # 2013-11-12 12:00:00 UTC
+
+
+def _read(lines: list[str]) -> tuple[AisBatch, RejectsLedger]:
+    ledger = RejectsLedger()
+    batches = list(read_nmea(lines, "log.nmea", ledger))
+    assert len(batches) == 1
+    batch = batches[0]
+    # Every message is one output row or one reader reject.
+    assert (
+        ledger.rows_read
+        == batch.positions.num_rows + batch.statics.num_rows + ledger.rejected_total
+    )
+    return batch, ledger
+
+
+def _checksum(body: str) -> str:
+    return f"{reduce(lambda acc, char: acc ^ ord(char), body, 0):02X}"
+
+
+def _tag(body: str) -> str:
+    return f"\\{body}*{_checksum(body)}\\"
+
+
+def _pghp(when: datetime) -> str:
+    body = f"PGHP,1,{when:%Y,%m,%d,%H,%M,%S},{when.microsecond // 1000},219,,2190067,1,00"
+    return f"${body}*{_checksum(body)}"
+
+
+def _sentences(channel: str = "A", seq_id: int | None = None, **fields: object) -> list[str]:
+    return encode_dict(fields, sentence_type="VDM", radio_channel=channel, seq_id=seq_id)
+
+
+def _position(mmsi: int = 219000001, **fields: object) -> str:
+    values: dict[str, object] = {"type": 1, "mmsi": mmsi, "lat": 57.05, "lon": 9.92}
+    values.update(fields)
+    (sentence,) = _sentences(**values)
+    return sentence
+
+
+def _type5(
+    mmsi: int = 219000001, seq_id: int = 3, channel: str = "A", **fields: object
+) -> list[str]:
+    values: dict[str, object] = {
+        "type": 5,
+        "mmsi": mmsi,
+        "shipname": "TEST SHIP",
+        "callsign": "OXAB",
+        "imo": 9123456,
+        "ship_type": 70,
+        "to_bow": 30,
+        "to_stern": 10,
+        "to_port": 4,
+        "to_starboard": 6,
+        "draught": 5.2,
+    }
+    values.update(fields)
+    return _sentences(channel=channel, seq_id=seq_id, **values)
+
+
+def _at(seconds: int, sentence: str) -> str:
+    return f"{sentence},{NOON + seconds}"
+
+
+def _rows(table: object) -> list[dict[str, object]]:
+    return table.to_pylist()  # type: ignore[attr-defined]
+
+
+# -- input forms ----------------------------------------------------------------------------
+
+
+def test_pghp_line_stamps_the_next_sentence_floored_to_the_second() -> None:
+    when = datetime(2013, 11, 12, 12, 0, 7, 979_000, tzinfo=UTC)
+    batch, _ = _read([_tag("si:AISD"), _pghp(when), _position()])
+    (row,) = _rows(batch.positions)
+    assert row["timestamp"] == datetime(2013, 11, 12, 12, 0, 7, tzinfo=UTC)
+    assert row["mmsi"] == 219000001
+    assert row["mobile_type"] == "Class A"
+
+
+def test_tag_block_c_on_the_same_line() -> None:
+    batch, _ = _read([_tag(f"s:rORBCOMM,c:{NOON + 42}") + _position()])
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 0, 42, tzinfo=UTC)
+
+
+def test_tag_block_c_in_milliseconds_and_alone_on_the_line_before() -> None:
+    batch, _ = _read([_tag(f"c:{(NOON + 5) * 1000 + 900}"), _position()])
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 0, 5, tzinfo=UTC)
+
+
+def test_trailing_unix_time_after_the_checksum() -> None:
+    batch, _ = _read([f"{_position()},{NOON + 61}.75"])
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 1, 1, tzinfo=UTC)
+
+
+def test_a_tag_block_c_beats_a_pending_pghp_time() -> None:
+    pghp = _pghp(datetime(2013, 11, 12, 13, 0, 0, tzinfo=UTC))
+    batch, _ = _read([pghp, _tag(f"c:{NOON}") + _position()])
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 0, 0, tzinfo=UTC)
+
+
+def test_bare_sentence_without_any_time_is_unparseable_with_an_example() -> None:
+    batch, ledger = _read([_position()])
+    assert batch.positions.num_rows == 0
+    assert ledger.rows_read == 1
+    assert ledger.rejects == {RejectReason.UNPARSEABLE.value: 1}
+    (example,) = ledger.examples[RejectReason.UNPARSEABLE.value]
+    assert example.startswith("log.nmea:1: no time")
+    assert _position() in example
+
+
+def test_pghp_time_is_used_by_the_next_sentence_only() -> None:
+    # DMA's $PSTT status line sits between a $PGHP and the next AIS sentence: the $PGHP
+    # stamped the $PSTT, so the AIS sentence after it has no time.
+    pghp = _pghp(datetime(2013, 11, 12, 12, 0, 0, tzinfo=UTC))
+    pstt = "$PSTT,30A,20131112,120000*6D"
+    batch, ledger = _read(
+        [pghp, _position(mmsi=219000001), _position(mmsi=219000002), pghp, pstt, _position()]
+    )
+    assert [row["mmsi"] for row in _rows(batch.positions)] == [219000001]
+    assert ledger.rejects == {RejectReason.UNPARSEABLE.value: 2}
+
+
+# -- reassembly -----------------------------------------------------------------------------
+
+
+def test_two_fragment_type5_is_reassembled_into_one_static_row() -> None:
+    fragments = _type5()
+    assert len(fragments) == 2
+    batch, ledger = _read([_at(0, fragments[0]), fragments[1]])
+    assert ledger.rows_read == 1
+    assert batch.positions.num_rows == 0
+    (row,) = _rows(batch.statics)
+    assert row == {
+        "timestamp": datetime(2013, 11, 12, 12, 0, 0, tzinfo=UTC),
+        "mmsi": 219000001,
+        "ship_type": "Cargo",
+        "length_m": 40.0,
+        "breadth_m": 10.0,
+        "draught_m": 5.2,
+        "name": "TEST SHIP",
+        "callsign": "OXAB",
+        "imo": 9123456,
+    }
+
+
+def test_interleaved_fragments_of_different_messages() -> None:
+    first = _type5(mmsi=219000001, seq_id=1, channel="A")
+    second = _type5(mmsi=219000002, seq_id=2, channel="A", draught=3.0)
+    third = _type5(mmsi=219000003, seq_id=1, channel="B", draught=7.5)
+    lines = [_at(0, first[0]), _at(1, second[0]), _at(2, third[0]), third[1], first[1], second[1]]
+    batch, ledger = _read(lines)
+    assert ledger.rejected_total == 0
+    got = {(row["mmsi"], row["draught_m"], row["timestamp"].second) for row in _rows(batch.statics)}
+    assert got == {(219000001, 5.2, 0), (219000002, 3.0, 1), (219000003, 7.5, 2)}
+
+
+def test_orphan_and_unfinished_fragments_are_incomplete() -> None:
+    head, tail = _type5(seq_id=4)
+    lines = [
+        _at(0, tail),  # a last fragment whose first never came
+        _at(1, head),  # a first fragment restarted by the next one with the same id
+        _at(2, head),
+        tail,  # completes the second start
+        _at(3, head),  # never finished
+    ]
+    batch, ledger = _read(lines)
+    assert batch.statics.num_rows == 1
+    assert _rows(batch.statics)[0]["timestamp"].second == 2
+    assert ledger.rows_read == 4
+    assert ledger.rejects == {RejectReason.INCOMPLETE_MULTIPART.value: 3}
+    assert ledger.examples[RejectReason.INCOMPLETE_MULTIPART.value][0].startswith(
+        "log.nmea:1: fragments 2 of 2"
+    )
+
+
+def test_a_gap_or_a_repeat_breaks_the_group_once() -> None:
+    first, second, third = _sentences(seq_id=9, type=8, mmsi=219000001, data=b"x" * 90)
+    complete = [_at(0, first), second, third]
+    repeated = [_at(1, first), second, second, third]
+    gap = [_at(2, first), third]
+    batch, ledger = _read(complete + repeated + gap)
+    assert batch.positions.num_rows == batch.statics.num_rows == 0
+    assert ledger.rows_read == 3
+    assert ledger.rejects == {
+        RejectReason.UNSUPPORTED_MESSAGE.value: 1,  # the complete type 8
+        RejectReason.INCOMPLETE_MULTIPART.value: 2,
+    }
+    repeat_example, gap_example = ledger.examples[RejectReason.INCOMPLETE_MULTIPART.value]
+    assert repeat_example.startswith("log.nmea:4: fragments 1,2,2,3 of 3: !AIVDM,3,1,9,A,")
+    assert gap_example.startswith("log.nmea:8: fragments 1,3 of 3: !AIVDM,3,1,9,A,")
+
+
+def test_bad_checksum_is_unparseable_and_orphans_the_rest_of_its_message() -> None:
+    single = _position()
+    bad_single = single[:-2] + ("00" if single[-2:] != "00" else "11")
+    head, tail = _type5(seq_id=6)
+    bad_head = head[:-2] + ("00" if head[-2:] != "00" else "11")
+    batch, ledger = _read([_at(0, bad_single), _at(1, bad_head), tail, "garbage line", ""])
+    assert batch.positions.num_rows == 0
+    assert batch.statics.num_rows == 0
+    assert ledger.rejects == {
+        RejectReason.UNPARSEABLE.value: 3,  # two bad checksums and the garbage line
+        RejectReason.INCOMPLETE_MULTIPART.value: 1,
+    }
+    examples = ledger.examples[RejectReason.UNPARSEABLE.value]
+    assert examples[0].startswith("log.nmea:1: checksum does not match: !AIVDM,1,1,")
+    assert examples[2] == "log.nmea:4: not an NMEA sentence: garbage line"
+
+
+# -- message types --------------------------------------------------------------------------
+
+
+def test_message_types_are_sorted_into_rows_and_rejects() -> None:
+    lines = [
+        _at(0, _position()),
+        _at(0, _sentences(type=4, mmsi=2190067)[0]),  # base station
+        _at(0, _sentences(type=9, mmsi=111219001)[0]),  # SAR aircraft
+        _at(0, _sentences(type=21, mmsi=992191001, name="BUOY")[0]),  # AtoN
+        _at(0, _sentences(type=8, mmsi=219000001, data=b"\x00")[0]),  # binary broadcast
+        _at(0, _sentences(type=18, mmsi=219000009, lat=57.0, lon=10.0)[0]),
+        _at(0, _sentences(type=24, partno=0, mmsi=219000009, shipname="SMALL")[0]),
+    ]
+    batch, ledger = _read(lines)
+    assert [row["mobile_type"] for row in _rows(batch.positions)] == ["Class A", "Class B"]
+    assert batch.statics.num_rows == 1
+    assert ledger.rejects == {
+        RejectReason.NOT_A_VESSEL.value: 3,
+        RejectReason.UNSUPPORTED_MESSAGE.value: 1,
+    }
+
+
+def test_truncated_payload_is_unparseable() -> None:
+    fields = _position().split(",")
+    body = ",".join([*fields[:5], fields[5][:20], "0"])[1:].split("*")[0]
+    batch, ledger = _read([_at(0, f"!{body}*{_checksum(body)}")])
+    assert batch.positions.num_rows == 0
+    assert ledger.rejects == {RejectReason.UNPARSEABLE.value: 1}
+    assert "payload has 120 bits, needs 137" in ledger.examples[RejectReason.UNPARSEABLE.value][0]
+
+
+def test_empty_payload_and_undefined_message_type_are_unparseable() -> None:
+    bodies = ["AIVDM,1,1,,A,,0", "AIVDM,1,1,,A,h000000000000000000000000000,0"]
+    _, ledger = _read([_at(0, f"!{body}*{_checksum(body)}") for body in bodies])
+    assert ledger.rejects == {RejectReason.UNPARSEABLE.value: 2}
+    empty, type48 = ledger.examples[RejectReason.UNPARSEABLE.value]
+    assert empty.startswith("log.nmea:1: empty payload: ")
+    assert type48.startswith("log.nmea:2: no AIS message type 48: ")
+
+
+# -- sentinels ------------------------------------------------------------------------------
+
+
+def test_not_available_values_become_null() -> None:
+    sentinels = _position(
+        lat=91, lon=181, speed=102.3, course=360, heading=511, turn=-128, status=15
+    )
+    batch, _ = _read([_at(0, sentinels)])
+    (row,) = _rows(batch.positions)
+    for name in ("lat_deg", "lon_deg", "sog_kn", "cog_deg", "heading_deg", "rot_deg_per_min"):
+        assert row[name] is None, name
+    assert row["nav_status"] == 15  # "undefined" is a real ITU code, kept as is
+
+
+def test_present_values_and_rate_of_turn() -> None:
+    # encode_dict stores turn 5 deg/min as round(4.733 * sqrt(5)) = 11; the ITU formula
+    # gives back (11 / 4.733)^2 = 5.4015 deg/min.
+    moving = _position(
+        lat=57.05, lon=9.92, speed=12.3, course=271.5, heading=270, turn=-5, status=0
+    )
+    batch, _ = _read([_at(0, moving)])
+    (row,) = _rows(batch.positions)
+    assert row["lat_deg"] == pytest.approx(57.05)
+    assert row["lon_deg"] == pytest.approx(9.92)
+    assert row["sog_kn"] == pytest.approx(12.3)
+    assert row["cog_deg"] == pytest.approx(271.5)
+    assert row["heading_deg"] == 270
+    assert row["rot_deg_per_min"] == pytest.approx(-((11 / 4.733) ** 2))
+    assert row["nav_status"] == 0
+    assert row["length_m"] is None  # no static report for this vessel
+
+
+def test_rate_of_turn_without_turn_indicator_is_null() -> None:
+    batch, _ = _read([_at(0, _position(turn=127)), _at(0, _position(turn=-127))])
+    assert [row["rot_deg_per_min"] for row in _rows(batch.positions)] == [None, None]
+
+
+def test_long_range_type27_sentinels() -> None:
+    absent = _sentences(type=27, mmsi=219000002, lat=91, lon=181, speed=63, course=511, status=5)[0]
+    present = _sentences(
+        type=27, mmsi=219000002, lat=57.1, lon=9.9, speed=62, course=359, status=5
+    )[0]
+    batch, _ = _read([_at(0, absent), _at(1, present)])
+    first, second = _rows(batch.positions)
+    assert (first["lat_deg"], first["lon_deg"], first["sog_kn"], first["cog_deg"]) == (
+        None,
+        None,
+        None,
+        None,
+    )
+    assert second["lat_deg"] == pytest.approx(57.1)
+    assert (second["sog_kn"], second["cog_deg"], second["nav_status"]) == (62.0, 359.0, 5)
+    assert second["heading_deg"] is None and second["mobile_type"] == "Class A"
+
+
+def test_zero_dimensions_draught_and_ship_type_are_null() -> None:
+    head, tail = _type5(
+        to_bow=0, to_stern=12, to_port=3, to_starboard=3, draught=0, ship_type=0, imo=0
+    )
+    batch, _ = _read([_at(0, head), tail])
+    (row,) = _rows(batch.statics)
+    assert row["length_m"] is None  # A = 0: the length is not known
+    assert row["breadth_m"] == 6.0
+    assert row["draught_m"] is None
+    assert row["ship_type"] is None
+    assert row["imo"] is None
+
+
+def test_type24_parts_and_type19_carry_their_own_statics() -> None:
+    part_a = _sentences(type=24, partno=0, mmsi=219000009, shipname="SMALL")[0]
+    part_b = _sentences(
+        type=24,
+        partno=1,
+        mmsi=219000009,
+        ship_type=37,
+        callsign="OU1234",
+        to_bow=5,
+        to_stern=4,
+        to_port=1,
+        to_starboard=2,
+    )[0]
+    type19 = _sentences(
+        type=19,
+        mmsi=219000010,
+        lat=57.0,
+        lon=10.0,
+        shipname="EXTENDED",
+        ship_type=52,
+        to_bow=20,
+        to_stern=8,
+        to_port=4,
+        to_starboard=4,
+    )[0]
+    batch, _ = _read([_at(0, part_a), _at(1, part_b), _at(2, type19)])
+    a, b = _rows(batch.statics)
+    assert (a["name"], a["length_m"], a["breadth_m"], a["ship_type"]) == ("SMALL", None, None, None)
+    assert (b["name"], b["length_m"], b["breadth_m"]) == (None, 9.0, 3.0)
+    assert (b["ship_type"], b["callsign"]) == ("Pleasure", "OU1234")
+    (position,) = _rows(batch.positions)
+    assert position["mobile_type"] == "Class B"
+    assert (position["name"], position["ship_type"]) == ("EXTENDED", "Tug")
+    assert (position["length_m"], position["breadth_m"]) == (28.0, 8.0)
+
+
+# -- static join ----------------------------------------------------------------------------
+
+
+def test_join_takes_each_field_from_the_nearest_report_that_has_it() -> None:
+    early = _type5(draught=4.0, seq_id=1)
+    late = _type5(draught=6.0, seq_id=2, to_bow=0)  # a later report that lost its length
+    name_only = _sentences(type=24, partno=0, mmsi=219000001, shipname="RENAMED")[0]
+    lines = [
+        _at(5, _position()),  # before every static report
+        _at(10, early[0]),
+        early[1],
+        _at(80, _position()),
+        _at(100, late[0]),
+        late[1],
+        _at(101, name_only),
+        _at(150, _position()),
+        _at(150, _position(mmsi=219000077)),  # a vessel with no static report
+    ]
+    batch, _ = _read(lines)
+    rows = _rows(batch.positions)
+    assert [row["draught_m"] for row in rows] == [4.0, 6.0, 6.0, None]
+    # Length: the nearest report with a length is the early one, for every position.
+    assert [row["length_m"] for row in rows] == [40.0, 40.0, 40.0, None]
+    assert [row["name"] for row in rows] == ["TEST SHIP", "TEST SHIP", "RENAMED", None]
+    assert [row["ship_type"] for row in rows] == ["Cargo", "Cargo", "Cargo", None]
+    assert [row["imo"] for row in rows] == [9123456, 9123456, 9123456, None]
+
+
+def test_type19_own_dimensions_win_over_joined_ones() -> None:
+    head, tail = _type5(mmsi=219000010, to_bow=50, to_stern=50)
+    type19 = _sentences(
+        type=19,
+        mmsi=219000010,
+        lat=57.0,
+        lon=10.0,
+        ship_type=52,
+        to_bow=20,
+        to_stern=8,
+        to_port=4,
+        to_starboard=4,
+    )[0]
+    type18 = _sentences(type=18, mmsi=219000010, lat=57.0, lon=10.0)[0]
+    batch, _ = _read([_at(0, head), tail, _at(1, type19), _at(2, type18)])
+    own, joined = _rows(batch.positions)
+    assert own["length_m"] == 28.0
+    assert own["draught_m"] == 5.2  # not in type 19, so joined from type 5
+    assert joined["length_m"] == 28.0  # the type 19 report is nearer than the type 5
+
+
+# -- other contract points ------------------------------------------------------------------
+
+
+def test_empty_input_gives_one_empty_batch() -> None:
+    batch, ledger = _read([])
+    assert batch.positions.num_rows == batch.statics.num_rows == ledger.rows_read == 0
+
+
+def test_loader_errors_propagate() -> None:
+    def truncated() -> Iterator[str]:
+        yield _at(0, _position())
+        raise InputFileError("log.nmea.gz: truncated gzip")
+
+    with pytest.raises(InputFileError, match="truncated gzip"):
+        list(read_nmea(truncated(), "log.nmea.gz", RejectsLedger()))
+
+
+def test_ship_type_categories() -> None:
+    assert 0 not in SHIP_TYPE_CATEGORIES
+    expected = {
+        30: "Fishing",
+        31: "Towing",
+        35: "Military",
+        36: "Sailing",
+        37: "Pleasure",
+        45: "HSC",
+    }
+    expected |= {50: "Pilot", 51: "SAR", 52: "Tug", 53: "Port tender", 55: "Law enforcement"}
+    expected |= {
+        58: "Medical",
+        60: "Passenger",
+        69: "Passenger",
+        70: "Cargo",
+        84: "Tanker",
+        99: "Other",
+    }
+    for code, text in expected.items():
+        assert SHIP_TYPE_CATEGORIES[code] == text
+    assert set(SHIP_TYPE_CATEGORIES) == set(range(1, 100))
+
+
+_POOL = [
+    _at(0, _position()),
+    _at(1, _position(mmsi=219000002, lat=91)),
+    *[_at(2, line) for line in _type5(seq_id=7)],
+    *_type5(seq_id=8, channel="B"),
+    _at(3, _sentences(type=4, mmsi=2190067)[0]),
+    "$PGHP,1,2013,11,12,12,0,0,11,219,,2190067,1,62*26",
+    _tag("si:AISD"),
+    "not nmea",
+    _position()[:-2] + "ZZ",
+]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.sampled_from(_POOL), max_size=25))
+def test_every_message_is_a_row_or_a_reject(lines: list[str]) -> None:
+    _read(lines)
+
+
+# -- the real DMA fixture -------------------------------------------------------------------
+#
+# Expected numbers come from an independent script that does not use pyais or this module:
+# it splits each !..VDM/!..VDO line on commas, verifies the XOR checksum, joins fragments by
+# (tag, channel, sequence id, count), turns the payload into a bit string (char - 48, minus 8
+# above 40, six bits each) and reads the type, MMSI and lat/lon fields at their ITU-R M.1371
+# bit offsets. It finds 80,246 lines, 26,146 sentences (69 two-fragment type 5 messages, all
+# complete, no bad checksum), so 26,077 messages: types 1: 20,044, 3: 4,151, 18: 493 (24,688
+# positions of 1,438 MMSIs), 5: 69 and 24: 61 (30 part A, 31 part B; 130 statics of 122
+# MMSIs), 4: 1,234 and 21: 25 (1,259 not vessels). SOURCES.md's "25,947 positions from 1,503
+# MMSIs" and "2,216 from 129 vessels" in the Limfjord box count base stations and AtoNs too:
+# 24,688 + 1,259 = 25,947 and 2,160 + 56 (two stations) = 2,216.
+
+
+@pytest.fixture(scope="module")
+def dma(fixtures_dir: Path) -> tuple[AisBatch, RejectsLedger]:
+    with gzip.open(
+        fixtures_dir / "ais" / "dma_nmea_2013-11-12_5min.txt.gz", "rt", encoding="ascii"
+    ) as log:
+        return _read(log.read().splitlines())
+
+
+def test_dma_fixture_counts(dma: tuple[AisBatch, RejectsLedger]) -> None:
+    batch, ledger = dma
+    positions = batch.positions.to_pandas()
+    assert ledger.rows_read == 26_077
+    assert len(positions) == 24_688
+    assert batch.statics.num_rows == 130
+    assert ledger.rejects == {RejectReason.NOT_A_VESSEL.value: 1_259}
+    assert ledger.rows_read == len(positions) + batch.statics.num_rows + ledger.rejected_total
+    assert positions["mmsi"].nunique() == 1_438
+    assert batch.statics.to_pandas()["mmsi"].nunique() == 122
+    assert positions["mobile_type"].value_counts().to_dict() == {"Class A": 24_195, "Class B": 493}
+    # Type 18 has no navigational status; every Class A report here has one.
+    assert positions["nav_status"].notna().sum() == 24_195
+    first = pd.Timestamp("2013-11-12 12:00:00", tz="UTC")
+    assert positions["timestamp"].min() == first
+    assert positions["timestamp"].max() == first + pd.Timedelta(seconds=299)
+
+
+def test_dma_fixture_limfjord_box(dma: tuple[AisBatch, RejectsLedger]) -> None:
+    positions = dma[0].positions.to_pandas()
+    box = positions[
+        positions["lat_deg"].between(56.5, 57.2) & positions["lon_deg"].between(8.2, 10.4)
+    ]
+    assert len(box) == 2_160
+    assert box["mmsi"].nunique() == 127
+
+
+def test_dma_fixture_static_join(dma: tuple[AisBatch, RejectsLedger]) -> None:
+    batch, _ = dma
+    positions = batch.positions.to_pandas()
+    # Independently: positions whose MMSI has a type 5 with draught > 0 (1,018 of 57 vessels)
+    # or a type 5 / 24B with A > 0 and B > 0 (1,273 of 94); 96 static rows have a length.
+    with_draught = positions[positions["draught_m"].notna()]
+    assert (len(with_draught), with_draught["mmsi"].nunique()) == (1_018, 57)
+    with_length = positions[positions["length_m"].notna()]
+    assert (len(with_length), with_length["mmsi"].nunique()) == (1_273, 94)
+    assert batch.statics.to_pandas()["length_m"].notna().sum() == 96
+    # The fishing vessel 205550000 "O-156": its type 5 (lines 3846-3848, $PGHP 12:00:12)
+    #   !BSVDM,2,1,3,B,5341id000000u0Ib220vo7GJ222222222222220N1p?5540Ht@1RDj2C,0*3B
+    #   !BSVDM,2,2,3,B,Qp1lSmCQ4p88880,2*29
+    # decodes by hand to A 15, B 15, C 5, D 5, draught 64 dm, ship type 30, IMO 0. Its first
+    # position (12:00:05) comes before that report and must still get the dimensions.
+    vessel = positions[positions["mmsi"] == 205550000]
+    assert len(vessel) > 0
+    assert vessel["timestamp"].min() < pd.Timestamp("2013-11-12 12:00:12", tz="UTC")
+    assert set(vessel["length_m"]) == {15.0 + 15.0}
+    assert set(vessel["breadth_m"]) == {5.0 + 5.0}
+    assert set(vessel["draught_m"]) == {6.4}
+    assert set(vessel["ship_type"]) == {"Fishing"}
+    assert set(vessel["name"]) == {"O-156"}
+    assert vessel["imo"].isna().all()
