@@ -1,0 +1,104 @@
+"""Parameters of the replay: the ``[replay]`` table of a query TOML.
+
+One table holds every knob of the tracks → encounters → rule 9 chain, so that a query file
+states the replay in one place. Defaults are the paper's Table "Simulation parameters"
+(time step 1 s, TCPA_act 3 min, CPA_req 150 m) and DESIGN §5.
+
+``[colregs]`` (sector angles, course source) is ``ColregsParams`` in ``colregs.py``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from enum import StrEnum
+from typing import Any
+
+from .config import dataclass_from_table
+from .errors import ParameterError
+from .units import METRES_PER_NAUTICAL_MILE
+
+
+class CourseSource(StrEnum):
+    """Which AIS field gives a vessel's course for bearings: COG, or heading (null → COG)."""
+
+    COG = "cog"
+    HEADING = "heading"
+
+
+@dataclass(frozen=True)
+class ReplayParams:
+    """The ``[replay]`` table.
+
+    - ``step_s``: the replay time step Δt; tracks are resampled to multiples of it (UTC).
+    - ``max_gap_s``: a track is split where two reports are more than this apart.
+    - ``max_speed_kn``: a report whose implied speed from the previous kept report exceeds
+      this is an implausible jump (see ``tracks.build_tracks``).
+    - ``min_sog_kn``: vessels slower than this are not under way and form no candidate pairs.
+    - ``candidate_range_m``: pairs closer than this (inclusive) are candidates (2 nm).
+    - ``tcpa_act_s``, ``cpa_req_m``: an encounter triggers at the first step with
+      ``0 <= TCPA <= tcpa_act_s`` and ``CPA < cpa_req_m``.
+    - ``course_change_deg``, ``speed_change_frac``: a vessel "acted" when her course changed by
+      at least this many degrees, or her speed by at least this fraction, before CPA.
+    - ``restricted_nav_statuses``: AIS navigational status codes that mean "restricted
+      manoeuvrability" for event d2 of the rule 9 automaton (3 restricted manoeuvrability,
+      4 constrained by her draught).
+    """
+
+    step_s: float = 1.0
+    max_gap_s: float = 300.0
+    max_speed_kn: float = 50.0
+    min_sog_kn: float = 0.5
+    candidate_range_m: float = 2.0 * METRES_PER_NAUTICAL_MILE
+    tcpa_act_s: float = 180.0
+    cpa_req_m: float = 150.0
+    course_change_deg: float = 15.0
+    speed_change_frac: float = 0.25
+    restricted_nav_statuses: frozenset[int] = frozenset({3, 4})
+
+    def __post_init__(self) -> None:
+        positive = (
+            "step_s",
+            "max_gap_s",
+            "max_speed_kn",
+            "candidate_range_m",
+            "cpa_req_m",
+            "course_change_deg",
+            "speed_change_frac",
+        )
+        for name in positive:
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                raise ParameterError(f"[replay] {name} = {value!r}: give a positive number")
+        for name in ("min_sog_kn", "tcpa_act_s"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ParameterError(f"[replay] {name} = {value!r}: give a number >= 0")
+        if self.max_gap_s < self.step_s:
+            raise ParameterError(
+                f"[replay] max_gap_s = {self.max_gap_s} is shorter than step_s = {self.step_s}; "
+                "give a gap of at least one step"
+            )
+        if self.course_change_deg > 180.0:
+            raise ParameterError(
+                f"[replay] course_change_deg = {self.course_change_deg}: a course change is at "
+                "most 180°; give a value in (0, 180]"
+            )
+        bad = sorted(
+            code
+            for code in self.restricted_nav_statuses
+            if isinstance(code, bool) or not isinstance(code, int) or not 0 <= code <= 15
+        )
+        if bad:
+            raise ParameterError(
+                f"[replay] restricted_nav_statuses contains {bad[0]!r}: AIS navigational "
+                "status codes are integers 0–15"
+            )
+
+
+def replay_params_from_table(table: dict[str, Any], where: str) -> ReplayParams:
+    """``ReplayParams`` from a ``[replay]`` TOML table; ``where`` names it in messages."""
+    return dataclass_from_table(ReplayParams, table, where)
+
+
+REPLAY_KEYS: tuple[str, ...] = tuple(f.name for f in fields(ReplayParams))

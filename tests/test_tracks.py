@@ -1,0 +1,309 @@
+"""Tracks: segmentation (gaps, jumps), missing SOG/COG, resampling on the absolute UTC grid."""
+
+from __future__ import annotations
+
+import gzip
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pytest
+
+from colregs9_cli.ais.ledger import RejectsLedger
+from colregs9_cli.ais.nmea import read_nmea
+from colregs9_cli.geo import LocalFrame
+from colregs9_cli.replay_params import CourseSource, ReplayParams
+from colregs9_cli.tracks import SAMPLE_COLUMNS, TrackStats, build_tracks
+from colregs9_cli.units import MPS_PER_KNOT
+
+FRAME = LocalFrame(57.05, 9.94)
+# 2024-01-01 12:00:00 UTC: a multiple of 5 s (and 1 s) since the Unix epoch.
+T0 = pd.Timestamp("2024-01-01T12:00:00Z")
+T0_S = 1_704_110_400
+
+
+def reports(
+    t_s: list[float],
+    north_m: list[float],
+    east_m: list[float],
+    mmsi: int = 219000001,
+    sog_kn: list[float] | float = 10.0,
+    cog_deg: list[float] | float = 0.0,
+    heading_deg: list[float] | float = np.nan,
+    nav_status: list[float] | float = 0,
+) -> pd.DataFrame:
+    """Position reports at T0 + t_s, given in the local frame."""
+    lat, lon = FRAME.to_geodetic(north_m, east_m)
+    n = len(t_s)
+    return pd.DataFrame(
+        {
+            "timestamp": [T0 + pd.Timedelta(seconds=s) for s in t_s],
+            "mmsi": [mmsi] * n,
+            "lat_deg": lat,
+            "lon_deg": lon,
+            "sog_kn": np.broadcast_to(np.asarray(sog_kn, dtype=float), n),
+            "cog_deg": np.broadcast_to(np.asarray(cog_deg, dtype=float), n),
+            "heading_deg": np.broadcast_to(np.asarray(heading_deg, dtype=float), n),
+            "nav_status": np.broadcast_to(np.asarray(nav_status, dtype=float), n),
+        }
+    )
+
+
+def northbound(t_s: list[float], speed_mps: float = 5.0) -> pd.DataFrame:
+    t = np.asarray(t_s, dtype=float)
+    return reports(list(t), list(speed_mps * t), [0.0] * len(t), sog_kn=speed_mps / MPS_PER_KNOT)
+
+
+def test_output_columns_and_sorting() -> None:
+    two = pd.concat([northbound([10, 0, 5]), reports([0, 4], [0, 0], [0, 8], mmsi=5, sog_kn=4.0)])
+    tracks = build_tracks(two, FRAME, ReplayParams())
+    samples = tracks.samples
+    assert tuple(samples.columns) == SAMPLE_COLUMNS
+    assert samples["mmsi"].tolist() == [5] * 5 + [219000001] * 11
+    assert (samples.groupby("mmsi")["step"].diff().dropna() == 1).all()
+    assert str(samples["timestamp"].dt.tz) == "UTC"
+    assert samples["nav_status"].dtype == "Int64"
+
+
+def test_gap_longer_than_max_gap_splits_and_leaves_the_gap_empty() -> None:
+    times = [*range(0, 101, 10), *range(401, 502, 10)]  # 101 → 401: a 300 s gap, then 301
+    tracks = build_tracks(northbound(times), FRAME, ReplayParams(max_gap_s=299.0))
+    assert tracks.stats.gap_splits == 1
+    assert tracks.stats.segments == 2
+    steps = tracks.samples["step"].to_numpy() - T0_S
+    assert steps.min() == 0 and steps.max() == 501
+    assert not np.any((steps > 100) & (steps < 401))
+    assert len(steps) == 101 + 101
+    assert tracks.samples["segment_id"].nunique() == 2
+
+
+def test_gap_equal_to_max_gap_does_not_split() -> None:
+    tracks = build_tracks(northbound([0, 300, 310]), FRAME, ReplayParams(max_gap_s=300.0))
+    assert tracks.stats.gap_splits == 0
+    assert tracks.stats.segments == 1
+    assert len(tracks.samples) == 311
+
+
+def test_isolated_speed_jump_is_dropped_and_counted() -> None:
+    # Northbound at 5 m/s; the report at t=30 claims 5 km east: 5000 m / 10 s ≈ 972 kn.
+    frame = northbound([0, 10, 20, 30, 40, 50])
+    lat, lon = FRAME.to_geodetic(150.0, 5000.0)
+    frame.loc[3, ["lat_deg", "lon_deg"]] = [float(lat), float(lon)]
+    tracks = build_tracks(frame, FRAME, ReplayParams())
+    assert tracks.stats.speed_jump_dropped == 1
+    assert tracks.stats.jump_splits == 0
+    assert tracks.stats.segments == 1
+    assert tracks.stats.reports_used == 5
+    # The dropped report leaves no trace: t=30 is interpolated from t=20 and t=40.
+    at_30 = tracks.samples.loc[tracks.samples["step"] == T0_S + 30]
+    assert at_30["north_m"].item() == pytest.approx(150.0, abs=1e-6)
+    assert at_30["east_m"].item() == pytest.approx(0.0, abs=1e-6)
+
+
+def test_last_report_jumping_is_dropped() -> None:
+    frame = northbound([0, 10, 20])
+    lat, lon = FRAME.to_geodetic(100.0, 3000.0)
+    frame.loc[2, ["lat_deg", "lon_deg"]] = [float(lat), float(lon)]
+    tracks = build_tracks(frame, FRAME, ReplayParams())
+    assert tracks.stats.speed_jump_dropped == 1
+    assert tracks.samples["step"].max() == T0_S + 10
+
+
+def test_confirmed_jump_splits_the_track_without_dropping() -> None:
+    # From t=30 the vessel is reported 5 km east, consistently: the position source moved.
+    t = [0, 10, 20, 30, 40, 50]
+    north = [0.0, 50.0, 100.0, 150.0, 200.0, 250.0]
+    east = [0.0, 0.0, 0.0, 5000.0, 5000.0, 5000.0]
+    tracks = build_tracks(reports(t, north, east), FRAME, ReplayParams())
+    assert tracks.stats.speed_jump_dropped == 0
+    assert tracks.stats.jump_splits == 1
+    assert tracks.stats.segments == 2
+    steps = tracks.samples["step"].to_numpy() - T0_S
+    # Nothing is interpolated across the jump (21..29 would be a 5 km slide).
+    assert steps.tolist() == [*range(0, 21), *range(30, 51)]
+
+
+def test_speed_exactly_at_the_limit_is_plausible() -> None:
+    limit_mps = 50.0 * MPS_PER_KNOT
+    frame = reports([0, 10], [0.0, 10 * limit_mps], [0.0, 0.0])
+    tracks = build_tracks(frame, FRAME, ReplayParams(max_speed_kn=50.0 * (1 + 1e-9)))
+    assert tracks.stats.speed_jump_dropped == 0
+    tracks = build_tracks(frame, FRAME, ReplayParams(max_speed_kn=50.0 * (1 - 1e-6)))
+    assert tracks.stats.speed_jump_dropped == 1
+
+
+def test_same_second_reports_keep_the_first() -> None:
+    frame = pd.concat([northbound([0, 10, 20]), northbound([10])], ignore_index=True)
+    frame.loc[3, "sog_kn"] = 99.0
+    tracks = build_tracks(frame, FRAME, ReplayParams())
+    assert tracks.stats.same_time_dropped == 1
+    assert tracks.stats.reports_used == 3
+    assert (tracks.samples["sog_kn"] < 99.0).all()
+
+
+def test_positions_and_speed_are_linear_in_time() -> None:
+    frame = reports([0, 10], [0.0, 100.0], [0.0, -40.0], sog_kn=[4.0, 6.0], cog_deg=350.0)
+    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    at_3 = samples.loc[samples["step"] == T0_S + 3].iloc[0]
+    assert at_3["north_m"] == pytest.approx(30.0, abs=1e-6)
+    assert at_3["east_m"] == pytest.approx(-12.0, abs=1e-6)
+    assert at_3["sog_kn"] == pytest.approx(4.6)
+    assert at_3["speed_mps"] == pytest.approx(4.6 * 1852 / 3600)
+    lat, lon = FRAME.to_geodetic(30.0, -12.0)
+    assert at_3["lat_deg"] == pytest.approx(float(lat), abs=1e-9)
+    assert at_3["lon_deg"] == pytest.approx(float(lon), abs=1e-9)
+
+
+def test_course_interpolates_across_north_along_the_short_arc() -> None:
+    frame = reports([0, 10], [0.0, 50.0], [0.0, 0.0], cog_deg=[359.0, 1.0])
+    samples = build_tracks(frame, FRAME, ReplayParams(step_s=0.5)).samples
+    course = dict(zip(samples["t_s"] - T0_S, samples["cog_deg"], strict=True))
+    assert course[5.0] == pytest.approx(0.0, abs=1e-9)  # not 180
+    assert course[2.5] == pytest.approx(359.5)
+    assert course[7.5] == pytest.approx(0.5)
+    assert ((samples["cog_deg"] >= 0) & (samples["cog_deg"] < 360)).all()
+
+
+def test_course_interpolates_the_other_way_too() -> None:
+    frame = reports([0, 4], [0.0, 20.0], [0.0, 0.0], cog_deg=[10.0, 350.0])
+    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    assert samples["cog_deg"].tolist() == pytest.approx([10.0, 5.0, 0.0, 355.0, 350.0])
+
+
+def test_no_extrapolation_and_grid_alignment() -> None:
+    # Reports at T0+2 s and T0+23 s; a 5 s grid gives samples at T0+5, 10, 15, 20 only.
+    frame = reports([2, 23], [0.0, 210.0], [0.0, 0.0])
+    tracks = build_tracks(frame, FRAME, ReplayParams(step_s=5.0))
+    samples = tracks.samples
+    assert (samples["t_s"] - T0_S).tolist() == [5.0, 10.0, 15.0, 20.0]
+    assert samples["step"].tolist() == [(T0_S + s) // 5 for s in (5, 10, 15, 20)]
+    assert samples["north_m"].tolist() == pytest.approx([30.0, 80.0, 130.0, 180.0])
+    assert samples["timestamp"].iloc[0] == T0 + pd.Timedelta(seconds=5)
+    assert tracks.step_to_timestamp(int(samples["step"].iloc[0])) == T0 + pd.Timedelta(seconds=5)
+
+
+def test_sub_second_report_times_stay_inside_the_segment() -> None:
+    frame = reports([0.4, 3.6], [0.0, 32.0], [0.0, 0.0])
+    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    assert (samples["t_s"] - T0_S).tolist() == pytest.approx([1.0, 2.0, 3.0])
+    assert samples["north_m"].tolist() == pytest.approx([6.0, 16.0, 26.0])
+
+
+def test_segment_between_grid_points_has_no_samples() -> None:
+    frame = reports([1, 3], [0.0, 10.0], [0.0, 0.0])
+    tracks = build_tracks(frame, FRAME, ReplayParams(step_s=5.0))
+    assert tracks.samples.empty
+    assert tracks.stats.segments == 1
+
+
+def test_missing_sog_and_cog_come_from_the_movement() -> None:
+    # East at 5 m/s, every report without SOG/COG; the last one stops (5 m in 10 s).
+    t = [0, 10, 20, 30]
+    east = [0.0, 50.0, 100.0, 105.0]
+    frame = reports(t, [0.0] * 4, east, sog_kn=np.nan, cog_deg=np.nan)
+    samples = build_tracks(frame, FRAME, ReplayParams()).samples.set_index("t_s")
+    # Central differences: (100 − 0)/20 s at t=10, (105 − 50)/20 s at t=20, one-sided at the ends.
+    assert samples.loc[T0_S + 0, "sog_kn"] == pytest.approx(5.0 / MPS_PER_KNOT)
+    assert samples.loc[T0_S + 10, "sog_kn"] == pytest.approx(5.0 / MPS_PER_KNOT)
+    assert samples.loc[T0_S + 20, "sog_kn"] == pytest.approx(2.75 / MPS_PER_KNOT)
+    assert samples.loc[T0_S + 30, "sog_kn"] == pytest.approx(0.5 / MPS_PER_KNOT)
+    assert samples["cog_deg"].to_numpy() == pytest.approx(90.0)
+
+
+def test_a_vessel_that_did_not_move_gets_no_course() -> None:
+    frame = reports([0, 10], [0.0, 0.0], [0.0, 0.0], sog_kn=np.nan, cog_deg=np.nan)
+    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    assert (samples["sog_kn"] == 0.0).all()
+    assert samples["cog_deg"].isna().all()
+
+
+def test_reported_sog_and_cog_are_kept() -> None:
+    frame = reports([0, 10], [0.0, 50.0], [0.0, 0.0], sog_kn=3.0, cog_deg=10.0)
+    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    assert samples["sog_kn"].to_numpy() == pytest.approx(3.0)
+    assert samples["cog_deg"].to_numpy() == pytest.approx(10.0)
+
+
+def test_course_source_heading_falls_back_to_cog() -> None:
+    frame = reports([0, 10, 20], [0.0, 50.0, 100.0], [0.0] * 3, cog_deg=0.0)
+    frame["heading_deg"] = [20.0, np.nan, 20.0]
+    by_cog = build_tracks(frame, FRAME, ReplayParams()).samples
+    by_heading = build_tracks(frame, FRAME, ReplayParams(), CourseSource.HEADING).samples
+    assert by_cog["course_deg"].to_numpy() == pytest.approx(0.0)
+    # Heading 20 at t=0, null → COG 0 at t=10, 20 at t=20.
+    expected = [20.0 - 2.0 * k for k in range(11)] + [2.0 * k for k in range(1, 11)]
+    assert by_heading["course_deg"].tolist() == pytest.approx(expected)
+    assert by_heading["heading_deg"].tolist() == pytest.approx(expected)
+    assert by_heading["cog_deg"].to_numpy() == pytest.approx(0.0)
+
+
+def test_nav_status_is_held_from_the_latest_report() -> None:
+    frame = northbound([0, 10, 20])
+    frame["nav_status"] = [0.0, 3.0, np.nan]
+    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    status = samples["nav_status"].tolist()
+    assert status[:10] == [0] * 10
+    assert status[10:20] == [3] * 10
+    assert status[20] is pd.NA
+
+
+def test_vessels_hold_the_last_known_static_values() -> None:
+    frame = northbound([0, 10, 20])
+    frame["length_m"] = [100.0, np.nan, np.nan]
+    frame["draught_m"] = [5.0, 6.5, np.nan]
+    frame["name"] = [None, "HAMLET", None]
+    other = reports([0, 10], [900.0, 900.0], [0.0, 50.0], mmsi=7)
+    tracks = build_tracks(pd.concat([frame, other], ignore_index=True), FRAME, ReplayParams())
+    vessels = tracks.vessels
+    assert vessels.index.tolist() == [7, 219000001]
+    assert vessels.loc[219000001, "length_m"] == 100.0
+    assert vessels.loc[219000001, "draught_m"] == 6.5
+    assert vessels.loc[219000001, "name"] == "HAMLET"
+    assert pd.isna(vessels.loc[7, "length_m"])
+
+
+def test_unclean_input_is_a_programming_error() -> None:
+    frame = northbound([0, 10])
+    with pytest.raises(ValueError, match="canonical columns"):
+        build_tracks(frame.drop(columns="cog_deg"), FRAME, ReplayParams())
+    frame.loc[1, "lat_deg"] = np.nan
+    with pytest.raises(ValueError, match="cleaned"):
+        build_tracks(frame, FRAME, ReplayParams())
+
+
+@pytest.mark.slow
+def test_real_nmea_sample(fixtures_dir: Path) -> None:
+    path = fixtures_dir / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
+    with gzip.open(path, "rt", errors="replace") as lines:
+        batches = list(read_nmea(lines, path.name, RejectsLedger()))
+    positions = pa.concat_tables([b.positions for b in batches]).to_pandas()
+    frame = LocalFrame.centred_on(
+        positions["lat_deg"].min(),
+        positions["lat_deg"].max(),
+        positions["lon_deg"].min(),
+        positions["lon_deg"].max(),
+    )
+    tracks = build_tracks(positions, frame, ReplayParams())
+    # Cross-checked with pandas on the same positions: 53 rows repeat an (mmsi, timestamp);
+    # the longest gap between a vessel's reports is 258 s (< 300, no gap split); after
+    # dropping the repeats, 21 consecutive pairs imply > 50 kn, all from three fast craft:
+    # 219017081 (≈34 kn, 17 isolated spikes from 1 s timestamp jitter: dropped),
+    # 235011610 (one 55 kn spike: dropped) and 219601000 (≈36 kn; three times a stale
+    # repeated position is followed by a jump that the next report confirms: split).
+    # The vessels' spans (last − first + 1 s) sum to 284,219 s; each split removes the one
+    # grid second between two reports 2 s apart, so 284,216 samples.
+    assert tracks.stats == TrackStats(
+        reports_in=24688,
+        reports_used=24688 - 53 - 18,
+        same_time_dropped=53,
+        speed_jump_dropped=18,
+        jump_splits=3,
+        gap_splits=0,
+        segments=1438 + 3,
+        samples=284216,
+    )
+    assert len(tracks.vessels) == 1438
+    assert tracks.samples["mmsi"].nunique() == 1438
+    split_vessels = tracks.samples.groupby("mmsi")["segment_id"].nunique()
+    assert split_vessels[split_vessels > 1].to_dict() == {219601000: 4}
