@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated
 
 import typer
 
@@ -46,3 +48,239 @@ def main(
 
     Example: colregs9 stats fixtures/ais/aisdk_2024-09-09_sample.csv
     """
+
+
+@app.command("replay")
+def replay_command(
+    ais: Annotated[
+        list[Path],
+        typer.Argument(
+            help="AIS files: DMA CSV (22/26 columns), MarineCadastre CSV or raw NMEA (.gz ok)."
+        ),
+    ],
+    chart: Annotated[
+        list[Path] | None,
+        typer.Option("--chart", help="Chart file (S-57 .000, GeoJSON, GeoPackage); repeatable."),
+    ] = None,
+    query: Annotated[
+        Path | None,
+        typer.Option(
+            "--query",
+            help="Query TOML: region, time window, vessels and the [replay], [colregs] and "
+            "[manoeuvrability] parameters. Without it: all the data, the paper's defaults.",
+        ),
+    ] = None,
+    own_mmsi: Annotated[
+        list[int] | None,
+        typer.Option(
+            "--own-mmsi", help="Vessel in the own-ship seat; repeatable. Default: every vessel."
+        ),
+    ] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", help="Output directory. Default: reports/replay-<query name>/."),
+    ] = None,
+    no_plots: Annotated[
+        bool, typer.Option("--no-plots", help="Do not draw the per-encounter PNGs.")
+    ] = False,
+    fmt: Annotated[
+        str | None,
+        typer.Option("--format", help="Input layout, when it cannot be detected from the file."),
+    ] = None,
+    step_s: Annotated[
+        float | None, typer.Option("--step-s", help="Replay time step Δt (s); 1.")
+    ] = None,
+    tcpa_act_s: Annotated[
+        float | None,
+        typer.Option("--tcpa-act-s", help="Trigger when 0 <= TCPA <= this (s); 180."),
+    ] = None,
+    cpa_req_m: Annotated[
+        float | None,
+        typer.Option("--cpa-req-m", help="Trigger when CPA is below this (m); 150."),
+    ] = None,
+    candidate_range_m: Annotated[
+        float | None,
+        typer.Option(
+            "--candidate-range-m", help="Pairs within this range are candidates (m); 3704 (2 nm)."
+        ),
+    ] = None,
+    min_sog_kn: Annotated[
+        float | None,
+        typer.Option("--min-sog-kn", help="Vessels slower than this form no pairs (kn); 0.5."),
+    ] = None,
+    alpha: Annotated[
+        float | None,
+        typer.Option("--alpha", help="Scale α of the rate of swing, in [0, 1]; 0.4."),
+    ] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
+) -> None:
+    """Replay AIS encounter by encounter through COLREGs rules 13–15 and the rule 9 automaton.
+
+    Writes encounters.csv, encounters/<id>.csv and .png, index.md and run.json, and prints a
+    summary of the triggered encounters. Without --chart, manoeuvrability is "unknown".
+
+    Example: colregs9 replay fixtures/ais/dma_nmea_2013-11-12_5min.txt.gz --no-plots
+    """
+    from .replay import run_replay
+
+    with _user_errors():
+        result = run_replay(
+            ais,
+            chart_paths=chart or [],
+            query_path=query,
+            own_mmsi=own_mmsi or [],
+            out_dir=out,
+            plots=not no_plots,
+            overrides={
+                "replay": {
+                    "step_s": step_s,
+                    "tcpa_act_s": tcpa_act_s,
+                    "cpa_req_m": cpa_req_m,
+                    "candidate_range_m": candidate_range_m,
+                    "min_sog_kn": min_sog_kn,
+                },
+                "manoeuvrability": {"alpha": alpha},
+            },
+            fmt=fmt,
+            quiet=quiet,
+        )
+    typer.echo(result.text, nl=False)
+    typer.echo(f"Reports in {result.out_dir}")
+
+
+@app.command("simulate")
+def simulate_command(
+    scenario: Annotated[
+        Path, typer.Argument(help="Scenario TOML (vessels, routes, speeds, timing, chart).")
+    ],
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", help="Output CSV. Default: reports/simulate-<scenario name>.csv."),
+    ] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
+) -> None:
+    """Simulate a scenario into synthetic AIS in the DMA 26-column CSV layout.
+
+    Checks that every route lies in water navigable for that vessel's draught on the
+    scenario's chart, then writes one report per vessel every ais_interval_s.
+
+    Example: colregs9 simulate fixtures/scenarios/greenhopper_restricted.toml
+    """
+    from .simulate import simulate_scenario
+
+    with _user_errors():
+        result = simulate_scenario(scenario, out, quiet=quiet)
+    typer.echo(result.text, nl=False)
+    typer.echo(f"AIS written to {result.out_path}")
+
+
+@app.command("stats")
+def stats_command(
+    ais: Annotated[
+        list[Path],
+        typer.Argument(
+            help="AIS files: DMA CSV (22/26 columns, .gz/.zip ok), MarineCadastre CSV, raw "
+            "NMEA or canonical Parquet."
+        ),
+    ],
+    query: Annotated[
+        Path | None,
+        typer.Option(
+            "--query", help="Query TOML (region, time window, vessels). Default: all the data."
+        ),
+    ] = None,
+    per: Annotated[
+        str,
+        typer.Option(
+            "--per",
+            help="vessel: one value per vessel, the median of its reports; message: every "
+            "position message in the query that has a value.",
+        ),
+    ] = "vessel",
+    by: Annotated[
+        str | None,
+        typer.Option("--by", help="ship_type: also one table per ship type."),
+    ] = None,
+    fmt: Annotated[
+        str | None,
+        typer.Option(
+            "--format",
+            help="Input layout instead of detecting it: dma26, dma22, marinecadastre, nmea, "
+            "parquet.",
+        ),
+    ] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", help="Output directory. Default: reports/stats-<query name>/."),
+    ] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bar.")] = False,
+) -> None:
+    """Vessel dimension statistics (length, breadth, draught), like the paper's table.
+
+    Writes dimension_stats.csv, dimension_stats.md, dimension_histograms.png and run.json and
+    prints the table. std is the sample standard deviation (ddof = 1), empty below 2 values.
+    Exit codes: 0 done, 2 bad input file, query or option, 3 the query selects no rows.
+
+    Example: colregs9 stats fixtures/ais/aisdk_2024-09-09_sample.csv --by ship_type
+    """
+    from .stats import run_stats
+
+    with _user_errors():
+        result = run_stats(ais, query_path=query, per=per, by=by, fmt=fmt, out_dir=out, quiet=quiet)
+    typer.echo(result.text, nl=False)
+    if not quiet:
+        typer.echo(f"Reports in {result.out_dir}", err=True)
+
+
+@app.command("swing")
+def swing_command(
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", help="Output directory. Default: reports/swing/."),
+    ] = None,
+) -> None:
+    """The rate of swing of the paper's 14 reference vessels: table, CSV and figure.
+
+    Prints the table with rate_of_swing_deg_per_m = 360 / (2π·turn_radius_m) and writes
+    rate_of_swing.csv and rate_of_swing.png (rate of swing against length, one marker per class).
+
+    Example: colregs9 swing --out reports/swing
+    """
+    from .swing import run_swing
+
+    with _user_errors():
+        report = run_swing(out)
+    typer.echo(report.text, nl=False)
+    typer.echo(f"Wrote {report.csv_path} and {report.png_path}")
+
+
+@app.command("chart")
+def chart_command(
+    charts: Annotated[
+        list[Path],
+        typer.Argument(help="Chart files (S-57 .000, GeoJSON, GeoPackage); several are merged."),
+    ],
+    draught: Annotated[
+        float | None,
+        typer.Option(
+            "--draught", help="Draught (m): print the navigable area for it and draw the chart."
+        ),
+    ] = None,
+    ukc: Annotated[
+        float, typer.Option("--ukc", help="Under-keel clearance added to the draught (m).")
+    ] = 0.0,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", help="Plot file (with --draught). Default: reports/chart-<stem>.png."),
+    ] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
+) -> None:
+    """Summarise charts: layers, depth range, extent; with --draught, the navigable water.
+
+    Example: colregs9 chart fixtures/charts/noaa_enc_US5MD1MC.000 --draught 5
+    """
+    from .chartinfo import summarise_chart
+
+    with _user_errors():
+        summary = summarise_chart(charts, draught_m=draught, ukc_m=ukc, out=out, quiet=quiet)
+    typer.echo(summary.text, nl=False)

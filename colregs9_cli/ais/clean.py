@@ -1,0 +1,222 @@
+"""Cleaning helpers shared by the readers: text to numbers, sentinels to nulls, code tables.
+
+"Not available" becomes null (DESIGN §4): latitude outside ±90 (91), longitude outside ±180
+(181), SOG 102.3 and above, COG 360 and above, heading 360 and above (511), a rate of turn
+beyond ±720 deg/min (the sentinel -128 decoded), dimension 0 or less, draught 0 or less, IMO
+0 or less, and the texts ``Unknown``, ``Undefined``, ``Unknown value`` and empty text in
+text columns.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+from numpy.typing import NDArray
+
+from .schema import VESSEL_MOBILE_TYPES
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+
+MMSI_MIN = 201_000_000  # MID 201: the lowest allocated maritime identification digits
+MMSI_MAX = 775_999_999  # MID 775
+MAX_ROT_DEG_PER_MIN = 720.0
+_NUMBER = r"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*$"
+_NULL_TEXTS = ["", "unknown", "undefined", "unknown value", "not available", "n/a"]
+NULL_TEXTS = frozenset(_NULL_TEXTS)
+
+# Navigational status text (DMA and others) -> ITU-R M.1371 code, matched after lower-casing
+# and dropping everything but letters. Unrecognised text maps to null.
+_NAV_STATUS_TEXTS: dict[str, int] = {
+    "underwayusingengine": 0,
+    "atanchor": 1,
+    "notundercommand": 2,
+    "restrictedmanoeuverability": 3,
+    "restrictedmaneuverability": 3,
+    "restrictedmanoeuvrability": 3,
+    "restrictedmaneuvrability": 3,
+    "restrictedmanouverability": 3,
+    "constrainedbyherdraught": 4,
+    "constrainedbyherdraft": 4,
+    "constrainedbydraught": 4,
+    "moored": 5,
+    "aground": 6,
+    "engagedinfishing": 7,
+    "underwaysailing": 8,
+    "reservedforhsc": 9,
+    "reservedforfutureamendmenthsc": 9,
+    "reservedforwig": 10,
+    "reservedforfutureamendmentwig": 10,
+    "powerdrivenvesseltowingastern": 11,
+    "powerdrivenvesselpushingaheadortowingalongside": 12,
+    "reservedforfutureuse": 13,
+    "aissart": 14,
+    "aissartisactive": 14,
+    "unknownvalue": 15,
+    "unknown": 15,
+    "undefined": 15,
+    "notdefined": 15,
+    "notdefineddefault": 15,
+}
+_NOT_LETTERS = re.compile(r"[^a-z]")
+
+
+def nav_status_code(text: str | None) -> int | None:
+    """The ITU code of a navigational status text; DMA's ``Unknown value`` is 15 ("not
+    defined", the AIS default), unrecognised or empty text is null."""
+    if text is None:
+        return None
+    key = _NOT_LETTERS.sub("", text.lower())
+    if not key:
+        return None
+    if key in _NAV_STATUS_TEXTS:
+        return _NAV_STATUS_TEXTS[key]
+    if key.startswith("restricted"):
+        return 3
+    if key.startswith("constrained"):
+        return 4
+    return None
+
+
+def nav_status_from_text(values: pa.Array | pa.ChunkedArray) -> pa.Array:
+    """Map a text column to int8 codes, looking each distinct text up once."""
+    encoded = pc.dictionary_encode(values)
+    if isinstance(encoded, pa.ChunkedArray):
+        encoded = encoded.combine_chunks()
+    codes = pa.array([nav_status_code(t) for t in encoded.dictionary.to_pylist()], pa.int8())
+    return pc.take(codes, encoded.indices)
+
+
+def to_float(values: pa.Array | pa.ChunkedArray) -> tuple[pa.Array, BoolArray]:
+    """A column as float64, and where it held text that is not a number.
+
+    Columns read as numbers pass through. Text is cast directly when it all parses, else
+    entry by entry: non-numeric text becomes null and is flagged, empty text is just null.
+    """
+    if isinstance(values, pa.ChunkedArray):
+        values = values.combine_chunks()
+    n = len(values)
+    if pa.types.is_floating(values.type) or pa.types.is_integer(values.type):
+        return values.cast(pa.float64()), np.zeros(n, dtype=bool)
+    if pa.types.is_null(values.type):
+        return pa.nulls(n, pa.float64()), np.zeros(n, dtype=bool)
+    blank = pc.equal(pc.utf8_trim_whitespace(values), "")
+    present = pc.and_(pc.invert(blank), pc.is_valid(values))
+    cleaned = pc.if_else(present, values, pa.scalar(None, pa.string()))
+    try:
+        return pc.cast(cleaned, pa.float64()), np.zeros(n, dtype=bool)
+    except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+        numeric = pc.fill_null(pc.match_substring_regex(cleaned, _NUMBER), False)
+        usable = pc.if_else(numeric, cleaned, pa.scalar(None, pa.string()))
+        bad = pc.and_(pc.fill_null(present, False), pc.invert(numeric))
+        return pc.cast(usable, pa.float64()), bad.to_numpy(zero_copy_only=False)
+
+
+def to_numpy_float(values: pa.Array) -> FloatArray:
+    return np.asarray(values.to_numpy(zero_copy_only=False), dtype=np.float64)
+
+
+def float_column(values: pa.Array | pa.ChunkedArray) -> tuple[FloatArray, BoolArray]:
+    array, bad = to_float(values)
+    return to_numpy_float(array), bad
+
+
+def null_outside(values: FloatArray, low: float, high: float) -> FloatArray:
+    """NaN where a value is outside [low, high] (the AIS sentinels lie outside)."""
+    with np.errstate(invalid="ignore"):
+        return np.where((values >= low) & (values <= high), values, np.nan)
+
+
+def positive_or_nan(values: FloatArray) -> FloatArray:
+    with np.errstate(invalid="ignore"):
+        return np.where(values > 0, values, np.nan)
+
+
+def clean_sog(values: FloatArray) -> FloatArray:
+    with np.errstate(invalid="ignore"):
+        return np.where((values >= 0) & (values < 102.25), values, np.nan)
+
+
+def clean_angle(values: FloatArray) -> FloatArray:
+    """COG or heading: [0, 360) is valid; 360 (COG) and 511 (heading) are not available."""
+    with np.errstate(invalid="ignore"):
+        return np.where((values >= 0) & (values < 360), values, np.nan)
+
+
+def clean_rot(values: FloatArray) -> FloatArray:
+    with np.errstate(invalid="ignore"):
+        cleaned = np.where(np.abs(values) <= MAX_ROT_DEG_PER_MIN, values, np.nan)
+    return cleaned + 0.0  # turns -0.0 into 0.0
+
+
+def dimension(first: FloatArray, second: FloatArray, total: FloatArray) -> FloatArray:
+    """Length as A+B (or breadth as C+D) when both are > 0, else the total column if > 0."""
+    with np.errstate(invalid="ignore"):
+        both = (first > 0) & (second > 0)
+    return np.where(both, first + second, positive_or_nan(total))
+
+
+def clean_text(values: pa.Array | pa.ChunkedArray) -> pa.Array:
+    """Trimmed text with the "not available" spellings (``Unknown``, empty, ...) as null."""
+    if isinstance(values, pa.ChunkedArray):
+        values = values.combine_chunks()
+    if pa.types.is_null(values.type):
+        return pa.nulls(len(values), pa.string())
+    text = pc.utf8_trim_whitespace(values.cast(pa.string()))
+    missing = pc.is_in(pc.utf8_lower(text), value_set=pa.array(_NULL_TEXTS))
+    return pc.if_else(missing, pa.scalar(None, pa.string()), text)
+
+
+def valid_mmsi(mmsi: NDArray[np.int64]) -> BoolArray:
+    """Nine digits with maritime identification digits (the first three) in 201-775."""
+    return (mmsi >= MMSI_MIN) & (mmsi <= MMSI_MAX)
+
+
+def is_vessel(mobile_type: pa.Array) -> BoolArray:
+    mask = pc.is_in(mobile_type, value_set=pa.array(sorted(VESSEL_MOBILE_TYPES)))
+    return np.asarray(pc.fill_null(mask, False).to_numpy(zero_copy_only=False), dtype=bool)
+
+
+@dataclass
+class Fields:
+    """What the pipeline needs of every row of a block before choosing the rows to keep.
+
+    ``mmsi`` is -1 where missing or not a number. ``unparseable`` marks rows with text
+    where a number belongs (in MMSI, latitude or longitude), with ``problem`` saying what
+    for the ledger's examples. Positions and dimensions are cleaned (NaN = not available).
+    """
+
+    mmsi: NDArray[np.int64]
+    lat_deg: FloatArray
+    lon_deg: FloatArray
+    vessel: BoolArray
+    length_m: FloatArray
+    breadth_m: FloatArray
+    draught_m: FloatArray
+    unparseable: BoolArray
+    problem: list[str]
+
+    def __len__(self) -> int:
+        return len(self.mmsi)
+
+
+def mmsi_column(values: pa.Array | pa.ChunkedArray) -> tuple[NDArray[np.int64], BoolArray]:
+    """MMSIs as int64 (-1 where missing or not an integer), and where the text was not a number."""
+    floats, bad = float_column(values)
+    whole = np.isfinite(floats) & (np.floor(floats) == floats)
+    bad = bad | (np.isfinite(floats) & ~whole)
+    return np.where(whole, floats, -1).astype(np.int64), bad
+
+
+def nan_to_null(values: np.ndarray) -> pa.Array:
+    return pa.array(values, pa.float64(), from_pandas=True)
+
+
+def whole_positive(values: np.ndarray) -> pa.Array:
+    with np.errstate(invalid="ignore"):
+        usable = (values > 0) & (np.floor(values) == values)
+    return pa.array(np.where(usable, values, 0).astype(np.int64), pa.int64(), mask=~usable)

@@ -1,0 +1,153 @@
+"""The Danish Maritime Authority "aisdk" CSV: the 26-column layout (with A, B, C, D) and the
+older 22-column one, read block by block.
+
+Column meanings: ``Timestamp`` is ``dd/mm/yyyy HH:MM:SS`` UTC; ``Navigational status`` is
+text (mapped to ITU codes by ``clean.nav_status_code``); ``Ship type`` is DMA's category
+text, kept as it is except ``Undefined`` (null); ``Type of mobile`` is the mobile type
+(``Class A``, ``Class B``, ``Base Station``, ``AtoN``, ...). Length is A+B and breadth C+D
+when both parts are > 0, otherwise the ``Length`` and ``Width`` columns.
+
+A row without a position that carries static fields (a dimension, draught, ship type,
+name, call sign or IMO) is a static report.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+
+from .clean import (
+    BoolArray,
+    Fields,
+    clean_angle,
+    clean_rot,
+    clean_sog,
+    clean_text,
+    dimension,
+    float_column,
+    is_vessel,
+    mmsi_column,
+    nan_to_null,
+    nav_status_from_text,
+    null_outside,
+    positive_or_nan,
+    whole_positive,
+)
+from .schema import CANONICAL_SCHEMA
+
+DMA_TIME_FORMAT = "%d/%m/%Y %H:%M:%S"
+# Columns read (DMA names, lower case); the rest of the file is skipped by the CSV reader.
+READ_COLUMNS = (
+    "timestamp",
+    "type of mobile",
+    "mmsi",
+    "latitude",
+    "longitude",
+    "navigational status",
+    "rot",
+    "sog",
+    "cog",
+    "heading",
+    "imo",
+    "callsign",
+    "name",
+    "ship type",
+    "width",
+    "length",
+    "draught",
+)
+ABCD = ("a", "b", "c", "d")
+# Columns the fast path reads as numbers; a file with text in one of them is read again
+# with every column as text (see load.py).
+NUMERIC_COLUMNS = (
+    "mmsi",
+    "latitude",
+    "longitude",
+    "rot",
+    "sog",
+    "cog",
+    "heading",
+    "width",
+    "length",
+    "draught",
+    *ABCD,
+)
+STATIC_TEXT_COLUMNS = ("ship type", "name", "callsign", "imo")
+
+
+def read_columns(has_abcd: bool) -> tuple[str, ...]:
+    return (*READ_COLUMNS, *ABCD) if has_abcd else READ_COLUMNS
+
+
+def _dimensions(batch: pa.RecordBatch, has_abcd: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    width, _ = float_column(batch.column("width"))
+    length, _ = float_column(batch.column("length"))
+    draught, _ = float_column(batch.column("draught"))
+    if has_abcd:
+        a, b, c, d = (float_column(batch.column(k))[0] for k in ABCD)
+        return dimension(a, b, length), dimension(c, d, width), positive_or_nan(draught)
+    return positive_or_nan(length), positive_or_nan(width), positive_or_nan(draught)
+
+
+def dma_fields(batch: pa.RecordBatch, has_abcd: bool) -> Fields:
+    mmsi, bad_mmsi = mmsi_column(batch.column("mmsi"))
+    lat, bad_lat = float_column(batch.column("latitude"))
+    lon, bad_lon = float_column(batch.column("longitude"))
+    length, breadth, draught = _dimensions(batch, has_abcd)
+    problem = np.where(bad_mmsi, "MMSI", np.where(bad_lat, "latitude", "longitude"))
+    return Fields(
+        mmsi=mmsi,
+        lat_deg=null_outside(lat, -90.0, 90.0),
+        lon_deg=null_outside(lon, -180.0, 180.0),
+        vessel=is_vessel(pc.utf8_trim_whitespace(batch.column("type of mobile"))),
+        length_m=length,
+        breadth_m=breadth,
+        draught_m=draught,
+        unparseable=bad_mmsi | bad_lat | bad_lon,
+        problem=problem.tolist(),
+    )
+
+
+def dma_static_text(batch: pa.RecordBatch) -> BoolArray:
+    """Rows that carry a ship type, name, call sign or IMO."""
+    present = np.zeros(batch.num_rows, dtype=bool)
+    for column in STATIC_TEXT_COLUMNS:
+        valid = pc.is_valid(clean_text(batch.column(column)))
+        present |= np.asarray(valid.to_numpy(zero_copy_only=False), dtype=bool)
+    return present
+
+
+def dma_canonical(batch: pa.RecordBatch, has_abcd: bool) -> tuple[pa.Table, BoolArray]:
+    """The rows in the canonical schema, and which had a timestamp that does not parse."""
+    stamps_text = pc.utf8_trim_whitespace(batch.column("timestamp"))
+    stamps = pc.strptime(stamps_text, format=DMA_TIME_FORMAT, unit="s", error_is_null=True)
+    bad_time = np.asarray(pc.is_null(stamps).to_numpy(zero_copy_only=False), dtype=bool)
+    mmsi, _ = mmsi_column(batch.column("mmsi"))
+    lat, _ = float_column(batch.column("latitude"))
+    lon, _ = float_column(batch.column("longitude"))
+    length, breadth, draught = _dimensions(batch, has_abcd)
+    imo, _ = float_column(clean_text(batch.column("imo")))
+    table = pa.table(
+        {
+            "timestamp": stamps.cast(pa.timestamp("s", tz="UTC")),
+            "mmsi": pa.array(mmsi, pa.int64()),
+            "lat_deg": nan_to_null(null_outside(lat, -90.0, 90.0)),
+            "lon_deg": nan_to_null(null_outside(lon, -180.0, 180.0)),
+            "sog_kn": nan_to_null(clean_sog(float_column(batch.column("sog"))[0])),
+            "cog_deg": nan_to_null(clean_angle(float_column(batch.column("cog"))[0])),
+            "heading_deg": nan_to_null(clean_angle(float_column(batch.column("heading"))[0])),
+            "rot_deg_per_min": nan_to_null(clean_rot(float_column(batch.column("rot"))[0])),
+            "nav_status": nav_status_from_text(batch.column("navigational status")),
+            "ship_type": clean_text(batch.column("ship type")),
+            "mobile_type": clean_text(batch.column("type of mobile")),
+            "length_m": nan_to_null(length),
+            "breadth_m": nan_to_null(breadth),
+            "draught_m": nan_to_null(draught),
+            "name": clean_text(batch.column("name")),
+            "callsign": clean_text(batch.column("callsign")),
+            "imo": whole_positive(imo),
+        },
+        schema=CANONICAL_SCHEMA,
+    )
+    return table, bad_time

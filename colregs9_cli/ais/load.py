@@ -1,0 +1,735 @@
+"""The load pipeline: open, detect, read by blocks, clean, filter by the query, account.
+
+Every input row ends in exactly one place of the ``RejectsLedger``, checked in this order
+(a row is counted at the first step that stops it, so later problems of the same row are
+not looked at):
+
+1. ``unparseable``: a line with the wrong number of fields, or text where the MMSI,
+   latitude or longitude must be a number (CSV); reader-level problems (NMEA).
+2. ``not_a_vessel``: a mobile type other than ``Class A``/``Class B`` (base station, AtoN,
+   SAR aircraft, ...). Checked before the MMSI, because base stations (00MID...) and AtoN
+   (99MID...) have MMSIs outside the ship range by design.
+3. ``invalid_mmsi``: not 9 digits, or maritime identification digits outside 201-775.
+4. No position (lat 91, lon 181, empty, out of range): a row that carries static fields
+   (a dimension, draught, ship type, name, call sign or IMO) is a static report and is
+   *used* (it feeds the per-vessel dimensions, not the positions); otherwise it is
+   ``position_not_available``. NMEA static messages (types 5, 24) are static reports; an
+   NMEA position message without a position is ``position_not_available``.
+5. Outside the query's region: ``outside_query``. Only rows inside the region have their
+   timestamps and text converted, which is what keeps a large file cheap.
+6. ``unparseable``: a timestamp that does not parse.
+7. Outside the vessel filter or the time window: ``outside_query``.
+8. ``duplicate``: a row equal in every canonical column to an earlier kept row (also across
+   files). Detected among the kept rows only.
+9. Otherwise the row is *used*: a position in ``AisData.positions``.
+
+``dimension_reports`` counts each distinct (length, breadth, draught) combination a vessel
+reported, over every row that passed steps 1-3 and carried a dimension, inside or outside
+the query, position rows and static reports alike, minus rows rejected in steps 6 and 8.
+It is restricted to the vessels that have a position in the query. Rows outside the region
+are not checked for a bad timestamp or duplicates, so they count as reports as they are.
+
+Memory: CSV is read in blocks of ``BLOCK_BYTES`` with pyarrow; a block is dropped once its
+rows in the query are kept, so memory grows with the kept rows, not with the file. A CSV
+whose numeric columns hold text somewhere is read a second time with every column as text
+(the fast first pass reads numbers directly). NMEA is decoded whole per file (see nmea.py).
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.csv as pacsv
+import pyarrow.parquet as pq
+
+from ..errors import InputFileError, NoDataError, ParameterError
+from ..progress import ProgressSink, progress_bar, progress_enabled
+from ..query import Query, everything_query
+from . import dma, marinecadastre
+from .batch import AisBatch
+from .clean import Fields, clean_text, is_vessel, null_outside, valid_mmsi
+from .detect import CSV_LAYOUTS, LAYOUTS, csv_header, detect_layout
+from .ledger import RejectReason, RejectsLedger
+from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
+from .sources import (
+    ReadaheadLimit,
+    Source,
+    decompression_error,
+    inspect_source,
+    locate_non_utf8,
+    open_data,
+    read_head,
+    sha256_file,
+)
+
+__all__ = ["LAYOUTS", "AisData", "InputFile", "load_ais"]
+
+BLOCK_BYTES = 16 * 1024 * 1024
+# Blocks the CSV reader may read ahead of the pipeline (memory: about this many blocks).
+READAHEAD_BLOCKS = 4
+PARQUET_BATCH_ROWS = 256 * 1024
+DIMENSIONS = ("length_m", "breadth_m", "draught_m")
+DIMENSION_REPORT_COLUMNS = ("mmsi", *DIMENSIONS, "n_reports")
+_EXAMPLE_CHARS = 160
+# Merge the per-block dimension counts once this many have piled up.
+_DIMENSION_PARTS_BEFORE_MERGE = 64
+
+
+@dataclass(frozen=True)
+class InputFile:
+    path: Path
+    sha256: str
+    layout: str
+    rows_read: int
+
+
+@dataclass(frozen=True)
+class AisData:
+    """Cleaned positions inside the query, with the vessels' dimension reports and the ledger.
+
+    ``positions``: ``CANONICAL_COLUMNS``, sorted by (mmsi, timestamp). ``dimension_reports``:
+    ``mmsi, length_m, breadth_m, draught_m, n_reports``, one row per distinct combination a
+    vessel reported (see the module docstring). ``rows_in_query == len(positions)``.
+    """
+
+    positions: pd.DataFrame
+    dimension_reports: pd.DataFrame
+    ledger: RejectsLedger
+    inputs: tuple[InputFile, ...]
+    rows_in_query: int
+
+
+def load_ais(
+    paths: Sequence[Path],
+    query: Query | None = None,
+    fmt: str | None = None,
+    quiet: bool = True,
+) -> AisData:
+    """Read AIS files (any mix of layouts) through ``query`` into cleaned positions.
+
+    ``fmt`` forces the layout of every file (one of ``LAYOUTS``); by default each file's
+    layout is detected from its content. Raises ``InputFileError`` for unreadable files,
+    ``NoDataError`` (exit code 3) when no position row is left in the query.
+    """
+    query = query if query is not None else everything_query()
+    if fmt is not None and fmt not in LAYOUTS:
+        raise ParameterError(f"--format {fmt!r} is not a layout; use one of {', '.join(LAYOUTS)}")
+    if not paths:
+        raise InputFileError("no AIS input files given; name at least one file")
+    sources = [inspect_source(Path(p)) for p in paths]
+    ledger = RejectsLedger()
+    collected = _Collected()
+    inputs: list[InputFile] = []
+    total_bytes = float(sum(s.size_bytes for s in sources))
+    with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet)) as bar:
+        for source in sources:
+            part = _read_source(source, fmt, query, bar)
+            _merge_ledger(ledger, part.ledger)
+            collected.extend(part)
+            inputs.append(InputFile(source.path, part.sha256, part.layout, part.ledger.rows_read))
+    positions, dimension_reports = collected.finish(ledger)
+    if positions.empty:
+        raise NoDataError(_no_data_message(query, ledger))
+    return AisData(positions, dimension_reports, ledger, tuple(inputs), len(positions))
+
+
+def _no_data_message(query: Query, ledger: RejectsLedger) -> str:
+    where = f"query '{query.name}'" + (f" ({query.source})" if query.source else "")
+    return (
+        f"the {where} selects no vessel positions: {ledger.rows_read} rows read, "
+        f"{ledger.rows_outside_query} outside the query, {ledger.rejected_total} rejected "
+        f"({', '.join(f'{k} {v}' for k, v in sorted(ledger.rejects.items())) or 'none'}); "
+        "check the region, time window and vessel filter against the data"
+    )
+
+
+def _merge_ledger(into: RejectsLedger, part: RejectsLedger) -> None:
+    into.read(part.rows_read)
+    into.use(part.rows_used)
+    into.outside_query(part.rows_outside_query)
+    for reason, count in part.rejects.items():
+        into.rejects[reason] += count
+    for reason, examples in part.examples.items():
+        bucket = into.examples.setdefault(reason, [])
+        bucket.extend(examples[: max(0, into.max_examples - len(bucket))])
+
+
+# -- one file ---------------------------------------------------------------------------------
+
+
+@dataclass
+class _FileResult:
+    """What one file contributed; merged into the run only when the file was read whole."""
+
+    query: Query
+    name: str
+    ledger: RejectsLedger = field(default_factory=RejectsLedger)
+    kept: list[pa.Table] = field(default_factory=list)
+    dimension_parts: list[pd.DataFrame] = field(default_factory=list)
+    layout: str = ""
+    sha256: str = ""
+
+    def add_dimensions(self, mmsi: np.ndarray, fields: Fields, rows: np.ndarray) -> None:
+        if not rows.any():
+            return
+        frame = pd.DataFrame(
+            {
+                "mmsi": mmsi[rows],
+                "length_m": fields.length_m[rows],
+                "breadth_m": fields.breadth_m[rows],
+                "draught_m": fields.draught_m[rows],
+            }
+        )
+        self.dimension_parts.append(_count_combinations(frame))
+        if len(self.dimension_parts) >= _DIMENSION_PARTS_BEFORE_MERGE:
+            self.dimension_parts = [_merge_counts(self.dimension_parts)]
+
+
+def _count_combinations(frame: pd.DataFrame) -> pd.DataFrame:
+    counts = frame.groupby(["mmsi", *DIMENSIONS], dropna=False, sort=False).size()
+    return counts.rename("n_reports").reset_index()
+
+
+def _merge_counts(parts: Sequence[pd.DataFrame]) -> pd.DataFrame:
+    merged = pd.concat(parts, ignore_index=True)
+    summed = merged.groupby(["mmsi", *DIMENSIONS], dropna=False, sort=False)["n_reports"].sum()
+    return summed.reset_index()
+
+
+def _read_source(source: Source, fmt: str | None, query: Query, bar: ProgressSink) -> _FileResult:
+    head = read_head(source)
+    layout = fmt if fmt is not None else detect_layout(source, head)
+    if layout == "parquet":
+        return _read_parquet(source, query, bar)
+    if layout == "nmea":
+        return _read_nmea(source, query, bar)
+    try:
+        return _read_csv(source, layout, head, query, bar, fast=True)
+    except _NeedsTextColumns:
+        return _read_csv(source, layout, head, query, _NO_PROGRESS, fast=False)
+
+
+class _NeedsTextColumns(Exception):
+    """A numeric column holds text somewhere: read the file again with text columns."""
+
+
+class _NoProgress:
+    def advance(self, amount: float = 1.0) -> None:
+        return None
+
+
+_NO_PROGRESS = _NoProgress()
+
+
+@dataclass(frozen=True)
+class _CsvLayout:
+    columns: tuple[str, ...]
+    numeric: tuple[str, ...]
+    fields: Callable[[pa.RecordBatch], Fields]
+    static_text: Callable[[pa.RecordBatch], np.ndarray]
+    canonical: Callable[[pa.RecordBatch], tuple[pa.Table, np.ndarray]]
+    example_columns: dict[str, str]  # what -> the column to quote in reject examples
+
+
+def _csv_layout(layout: str) -> _CsvLayout:
+    if layout in ("dma26", "dma22"):
+        abcd = layout == "dma26"
+        return _CsvLayout(
+            columns=dma.read_columns(abcd),
+            numeric=tuple(c for c in dma.NUMERIC_COLUMNS if abcd or c not in dma.ABCD),
+            fields=lambda b: dma.dma_fields(b, abcd),
+            static_text=dma.dma_static_text,
+            canonical=lambda b: dma.dma_canonical(b, abcd),
+            example_columns={
+                "MMSI": "mmsi",
+                "latitude": "latitude",
+                "longitude": "longitude",
+                "mobile": "type of mobile",
+                "time": "timestamp",
+            },
+        )
+    return _CsvLayout(
+        columns=marinecadastre.READ_COLUMNS,
+        numeric=marinecadastre.NUMERIC_COLUMNS,
+        fields=marinecadastre.marinecadastre_fields,
+        static_text=marinecadastre.marinecadastre_static_text,
+        canonical=marinecadastre.marinecadastre_canonical,
+        example_columns={
+            "MMSI": "mmsi",
+            "latitude": "lat",
+            "longitude": "lon",
+            "mobile": "transceiverclass",
+            "time": "basedatetime",
+        },
+    )
+
+
+class _LineNumbers:
+    """Line numbers of CSV data rows, given the lines the reader skipped as invalid."""
+
+    def __init__(self, first_data_line: int) -> None:
+        self.first_data_line = first_data_line
+        self.invalid_lines: list[int] = []
+
+    def line_of(self, row: int) -> int:
+        """The file line of the ``row``-th (0-based) valid data row."""
+        line = self.first_data_line + row
+        for invalid in self.invalid_lines:
+            if invalid > line:
+                break
+            line += 1
+        return line
+
+
+def _read_csv(
+    source: Source, layout: str, head: bytes, query: Query, bar: ProgressSink, fast: bool
+) -> _FileResult:
+    if layout not in CSV_LAYOUTS:
+        raise ParameterError(
+            f"--format {layout!r} is not a layout; use one of {', '.join(LAYOUTS)}"
+        )
+    spec = _csv_layout(layout)
+    header = csv_header(head, layout)
+    missing = [c for c in spec.columns if c not in header.columns]
+    if missing:
+        raise InputFileError(
+            f"{source.name}: the {layout} layout needs the column {missing[0]!r}, which the "
+            f"header does not have; check the file or the --format given"
+        )
+    result = _FileResult(query, source.name, layout=layout)
+    lines = _LineNumbers(2 if header.has_header else 1)
+
+    def invalid_row(row: Any) -> str:
+        result.ledger.read()
+        if row.number is not None:
+            lines.invalid_lines.append(row.number)
+        result.ledger.reject(
+            RejectReason.UNPARSEABLE,
+            example=f"{source.name}:{row.number}: expected {row.expected_columns} fields, found "
+            f"{row.actual_columns}: {row.text[:_EXAMPLE_CHARS]}",
+        )
+        return "skip"
+
+    column_types = {
+        c: (pa.float64() if fast and c in spec.numeric else pa.string()) for c in spec.columns
+    }
+    read_options = pacsv.ReadOptions(
+        column_names=list(header.columns),
+        skip_rows=1 if header.has_header else 0,
+        block_size=BLOCK_BYTES,
+        use_threads=False,  # keeps the invalid rows' line numbers
+    )
+    parse_options = pacsv.ParseOptions(invalid_row_handler=invalid_row)
+    convert_options = pacsv.ConvertOptions(
+        column_types=column_types,
+        include_columns=list(spec.columns),
+        strings_can_be_null=False,
+        quoted_strings_can_be_null=False,
+    )
+    rows_before = 0
+    with open_data(source, bar) as opened:
+        limited = ReadaheadLimit(opened.stream, READAHEAD_BLOCKS)
+        try:
+            reader = pacsv.open_csv(
+                limited,
+                read_options=read_options,
+                parse_options=parse_options,
+                convert_options=convert_options,
+            )
+            for batch in reader:
+                limited.consumed()
+                _csv_block(result, spec, batch, rows_before, lines)
+                rows_before += batch.num_rows
+        except pa.ArrowInvalid as exc:
+            raise _csv_error(source, exc, fast) from None
+        finally:
+            limited.release()
+        result.sha256 = opened.finish()
+    return result
+
+
+def _csv_error(source: Source, exc: pa.ArrowInvalid, fast: bool) -> Exception:
+    message = str(exc)
+    if "UTF8" in message or "UTF-8" in message:
+        located = locate_non_utf8(source)
+        if located is not None:
+            line, offset, byte = located
+            return InputFileError(
+                f"{source.name}:{line}: byte 0x{byte:02x} at offset {offset} is not UTF-8; "
+                "convert the file to UTF-8 (e.g. iconv -f latin1 -t utf-8)"
+            )
+    if fast and "conversion error" in message:
+        return _NeedsTextColumns()
+    if "Empty CSV" in message:
+        return InputFileError(f"{source.name}: no CSV data; give a file with AIS rows")
+    return InputFileError(f"{source.name}: cannot read the CSV ({message}); check the file")
+
+
+def _csv_block(
+    result: _FileResult,
+    spec: _CsvLayout,
+    batch: pa.RecordBatch,
+    rows_before: int,
+    lines: _LineNumbers,
+) -> None:
+    n = batch.num_rows
+    result.ledger.read(n)
+
+    def example(row: int, what: str, why: str) -> str:
+        value = batch.column(spec.example_columns[what])[row].as_py()
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        return f"{result.name}:{lines.line_of(rows_before + row)}: {why} {value!r}"
+
+    _classify(
+        result,
+        spec.fields(batch),
+        batch,
+        static_text=spec.static_text,
+        canonical=spec.canonical,
+        example=example,
+    )
+
+
+Example = Callable[[int, str, str], str]
+
+
+def _classify(
+    result: _FileResult,
+    fields: Fields,
+    batch: pa.RecordBatch | pa.Table,
+    static_text: Callable[[Any], np.ndarray] | None,
+    canonical: Callable[[Any], tuple[pa.Table, np.ndarray]],
+    example: Example,
+) -> None:
+    """Account every row of one block (see the module docstring) and keep the query's rows."""
+    ledger = result.ledger
+    query = result.query
+    left = np.ones(len(fields), dtype=bool)
+
+    def reject(mask: np.ndarray, reason: RejectReason, what: str, why: str) -> None:
+        rows = np.flatnonzero(mask)
+        if rows.size:
+            ledger.reject(reason, int(rows.size), example=example(int(rows[0]), what, why))
+
+    unparseable = fields.unparseable
+    if unparseable.any():
+        first = int(np.flatnonzero(unparseable)[0])
+        what = fields.problem[first]
+        reject(unparseable, RejectReason.UNPARSEABLE, what, f"{what} is not a number:")
+    left &= ~unparseable
+    not_vessel = left & ~fields.vessel
+    reject(not_vessel, RejectReason.NOT_A_VESSEL, "mobile", "mobile type")
+    left &= ~not_vessel
+    bad_mmsi = left & ~valid_mmsi(fields.mmsi)
+    reject(bad_mmsi, RejectReason.INVALID_MMSI, "MMSI", "MMSI")
+    left &= ~bad_mmsi
+
+    has_dimension = ~(
+        np.isnan(fields.length_m) & np.isnan(fields.breadth_m) & np.isnan(fields.draught_m)
+    )
+    no_position = left & (np.isnan(fields.lat_deg) | np.isnan(fields.lon_deg))
+    static_report = no_position & has_dimension
+    if static_text is not None and no_position.any():
+        rows = np.flatnonzero(no_position)
+        static_report[rows] |= static_text(batch.take(pa.array(rows)))
+    elif static_text is None:
+        static_report[:] = False
+    ledger.use(int(static_report.sum()))
+    reject(
+        no_position & ~static_report,
+        RejectReason.NO_POSITION,
+        "latitude",
+        "no position: latitude",
+    )
+    contributes = left & has_dimension
+    contributes &= ~(no_position & ~static_report)
+    left &= ~no_position
+
+    if query.region is not None and left.any():
+        rows = np.flatnonzero(left)
+        inside = query.region.contains(fields.lat_deg[rows], fields.lon_deg[rows])
+        ledger.outside_query(int((~inside).sum()))
+        left[rows[~inside]] = False
+    rows = np.flatnonzero(left)
+    if rows.size:
+        table, bad_time = canonical(batch.take(pa.array(rows)))
+        if bad_time.any():
+            first = int(rows[np.flatnonzero(bad_time)[0]])
+            ledger.reject(
+                RejectReason.UNPARSEABLE,
+                int(bad_time.sum()),
+                example=example(first, "time", "timestamp does not parse:"),
+            )
+            contributes[rows[bad_time]] = False
+            table = table.filter(pa.array(~bad_time))
+        selected = _in_query(table, query)
+        ledger.outside_query(int((~selected).sum()))
+        result.kept.append(table.filter(pa.array(selected)))
+    result.add_dimensions(fields.mmsi, fields, contributes)
+
+
+def _in_query(table: pa.Table, query: Query) -> np.ndarray:
+    """Rows inside the time window and the vessel filter."""
+    keep = np.ones(table.num_rows, dtype=bool)
+    window = query.time
+    if not window.unbounded:
+        seconds = table.column("timestamp").cast(pa.int64()).to_numpy()
+        if window.start is not None:
+            keep &= seconds >= int(window.start.timestamp())
+        if window.end is not None:
+            keep &= seconds < int(window.end.timestamp())
+    if not query.vessels.selects_all:
+        keep &= query.vessels.selects(
+            table.column("mmsi").to_numpy(),
+            table.column("mobile_type").to_numpy(zero_copy_only=False),
+            table.column("ship_type").to_numpy(zero_copy_only=False),
+            table.column("length_m").to_numpy(zero_copy_only=False),
+        )
+    return keep
+
+
+# -- canonical tables (NMEA, Parquet) ---------------------------------------------------------
+
+
+def _canonical_fields(table: pa.Table) -> Fields:
+    mmsi = pc.fill_null(table.column("mmsi"), -1).to_numpy()
+
+    def floats(name: str) -> np.ndarray:
+        return np.asarray(table.column(name).to_numpy(zero_copy_only=False), dtype=np.float64)
+
+    n = table.num_rows
+    return Fields(
+        mmsi=np.asarray(mmsi, dtype=np.int64),
+        lat_deg=null_outside(floats("lat_deg"), -90.0, 90.0),
+        lon_deg=null_outside(floats("lon_deg"), -180.0, 180.0),
+        vessel=is_vessel(table.column("mobile_type").combine_chunks()),
+        length_m=floats("length_m"),
+        breadth_m=floats("breadth_m"),
+        draught_m=floats("draught_m"),
+        unparseable=np.zeros(n, dtype=bool),
+        problem=[],
+    )
+
+
+def _canonical_identity(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
+    bad_time = table.column("timestamp").is_null().to_numpy(zero_copy_only=False)
+    return table, np.asarray(bad_time, dtype=bool)
+
+
+def _canonical_static_text(table: pa.Table) -> np.ndarray:
+    present = np.zeros(table.num_rows, dtype=bool)
+    for column in ("ship_type", "name", "callsign", "imo"):
+        present |= np.asarray(table.column(column).is_valid().to_numpy(zero_copy_only=False))
+    return present
+
+
+def _table_example(name: str, table: pa.Table) -> Example:
+    def example(row: int, what: str, why: str) -> str:
+        column = {"MMSI": "mmsi", "mobile": "mobile_type", "time": "timestamp"}.get(what, "lat_deg")
+        value = table.column(column)[row].as_py()
+        mmsi = table.column("mmsi")[row].as_py()
+        if what == "MMSI":
+            return f"{name}: MMSI {mmsi}"
+        return f"{name}: MMSI {mmsi}: {why} {value!r}"
+
+    return example
+
+
+def _read_nmea(source: Source, query: Query, bar: ProgressSink) -> _FileResult:
+    from .nmea import read_nmea
+
+    result = _FileResult(query, source.name, layout="nmea")
+    with open_data(source, bar) as opened:
+        text = io.TextIOWrapper(opened.stream, encoding="utf-8", errors="replace", newline="")
+        try:
+            batches = list(read_nmea(_lines(text), source.name, result.ledger))
+        except (EOFError, OSError) as exc:
+            raise decompression_error(source, exc) from None
+        result.sha256 = opened.finish()
+    for batch in batches:
+        _nmea_batch(result, batch)
+    return result
+
+
+def _lines(text: io.TextIOWrapper) -> Iterator[str]:
+    for line in text:
+        yield line.rstrip("\r\n")
+
+
+def _nmea_batch(result: _FileResult, batch: AisBatch) -> None:
+    positions = batch.positions
+    _classify(
+        result,
+        _canonical_fields(positions),
+        positions,
+        static_text=None,
+        canonical=_canonical_identity,
+        example=_table_example(result.name, positions),
+    )
+    statics = batch.statics
+    if statics.num_rows == 0:
+        return
+    mmsi = np.asarray(pc.fill_null(statics.column("mmsi"), -1).to_numpy(), dtype=np.int64)
+    bad = ~valid_mmsi(mmsi)
+    if bad.any():
+        first = int(np.flatnonzero(bad)[0])
+        result.ledger.reject(
+            RejectReason.INVALID_MMSI,
+            int(bad.sum()),
+            example=f"{result.name}: static report: MMSI {int(mmsi[first])}",
+        )
+    result.ledger.use(int((~bad).sum()))
+    dims = {
+        name: np.asarray(statics.column(name).to_numpy(zero_copy_only=False), dtype=np.float64)
+        for name in DIMENSIONS
+    }
+    fields = Fields(
+        mmsi=mmsi,
+        lat_deg=np.full(len(mmsi), np.nan),
+        lon_deg=np.full(len(mmsi), np.nan),
+        vessel=np.ones(len(mmsi), dtype=bool),
+        length_m=dims["length_m"],
+        breadth_m=dims["breadth_m"],
+        draught_m=dims["draught_m"],
+        unparseable=np.zeros(len(mmsi), dtype=bool),
+        problem=[],
+    )
+    has_dimension = ~(
+        np.isnan(fields.length_m) & np.isnan(fields.breadth_m) & np.isnan(fields.draught_m)
+    )
+    result.add_dimensions(mmsi, fields, ~bad & has_dimension)
+
+
+def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResult:
+    if source.compression != "none":
+        raise InputFileError(
+            f"{source.name}: a compressed Parquet file; give the .parquet file itself"
+        )
+    result = _FileResult(query, source.name, layout="parquet")
+    try:
+        parquet = pq.ParquetFile(source.path)
+    except (pa.ArrowException, OSError) as exc:
+        raise InputFileError(f"{source.name}: not a readable Parquet file ({exc})") from None
+    names = parquet.schema_arrow.names
+    missing = [c for c in CANONICAL_COLUMNS if c not in names]
+    if missing:
+        raise InputFileError(
+            f"{source.name}: the Parquet file lacks the canonical column {missing[0]!r}; "
+            f"it needs {', '.join(CANONICAL_COLUMNS)}"
+        )
+    example = None
+    try:
+        for record_batch in parquet.iter_batches(
+            batch_size=PARQUET_BATCH_ROWS, columns=list(CANONICAL_COLUMNS)
+        ):
+            table = _to_canonical(source, pa.Table.from_batches([record_batch]))
+            result.ledger.read(table.num_rows)
+            example = _table_example(result.name, table)
+            _classify(
+                result,
+                _canonical_fields(table),
+                table,
+                static_text=_canonical_static_text,
+                canonical=_canonical_identity,
+                example=example,
+            )
+    except (pa.ArrowException, OSError) as exc:
+        raise InputFileError(f"{source.name}: cannot read the Parquet file ({exc})") from None
+    bar.advance(source.size_bytes)
+    result.sha256 = sha256_file(source.path)
+    return result
+
+
+def _to_canonical(source: Source, table: pa.Table) -> pa.Table:
+    columns = []
+    for target in CANONICAL_SCHEMA:
+        column = table.column(target.name)
+        if pa.types.is_timestamp(column.type) and column.type.tz is None:
+            column = column.cast(pa.timestamp(column.type.unit, tz="UTC"))
+        if target.name in ("ship_type", "mobile_type", "name", "callsign"):
+            column = clean_text(column.cast(pa.string()))
+        try:
+            columns.append(column.cast(target.type, safe=target.name != "timestamp"))
+        except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
+            raise InputFileError(
+                f"{source.name}: column {target.name!r} of type {column.type} cannot be read as "
+                f"{target.type} ({exc})"
+            ) from None
+    return pa.Table.from_arrays(columns, schema=CANONICAL_SCHEMA)
+
+
+# -- the run ----------------------------------------------------------------------------------
+
+
+@dataclass
+class _Collected:
+    kept: list[pa.Table] = field(default_factory=list)
+    dimension_parts: list[pd.DataFrame] = field(default_factory=list)
+
+    def extend(self, part: _FileResult) -> None:
+        self.kept.extend(part.kept)
+        if part.dimension_parts:
+            self.dimension_parts.append(_merge_counts(part.dimension_parts))
+
+    def finish(self, ledger: RejectsLedger) -> tuple[pd.DataFrame, pd.DataFrame]:
+        """Sort, drop exact duplicates (ledger), and count the used rows."""
+        table = pa.concat_tables(self.kept) if self.kept else CANONICAL_SCHEMA.empty_table()
+        positions = _to_pandas(table)
+        positions = positions.sort_values(["mmsi", "timestamp"], kind="stable", ignore_index=True)
+        duplicate = positions.duplicated(keep="first").to_numpy()
+        counts = _merge_counts(self.dimension_parts) if self.dimension_parts else _empty_counts()
+        if duplicate.any():
+            dropped = positions.loc[duplicate]
+            first = dropped.iloc[0]
+            ledger.reject(
+                RejectReason.DUPLICATE,
+                int(duplicate.sum()),
+                example=f"MMSI {first['mmsi']} at {first['timestamp']}: repeated row",
+            )
+            counts = _subtract_counts(counts, dropped)
+            positions = positions.loc[~duplicate].reset_index(drop=True)
+        ledger.use(len(positions))
+        vessels = np.unique(positions["mmsi"].to_numpy())
+        reports = counts[counts["mmsi"].isin(vessels) & (counts["n_reports"] > 0)]
+        reports = reports.sort_values(["mmsi", *DIMENSIONS], ignore_index=True)
+        reports["n_reports"] = reports["n_reports"].astype(np.int64)
+        return positions, reports[list(DIMENSION_REPORT_COLUMNS)]
+
+
+def _empty_counts() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "mmsi": np.array([], dtype=np.int64),
+            **{d: np.array([], dtype=np.float64) for d in DIMENSIONS},
+            "n_reports": np.array([], dtype=np.int64),
+        }
+    )
+
+
+def _subtract_counts(counts: pd.DataFrame, dropped: pd.DataFrame) -> pd.DataFrame:
+    frame = dropped[["mmsi", *DIMENSIONS]].astype({d: np.float64 for d in DIMENSIONS})
+    frame = frame[frame[list(DIMENSIONS)].notna().any(axis=1)]
+    if frame.empty:
+        return counts
+    removed = _count_combinations(frame)
+    removed["n_reports"] = -removed["n_reports"]
+    return _merge_counts([counts, removed])
+
+
+def _to_pandas(table: pa.Table) -> pd.DataFrame:
+    """Canonical columns: int64 MMSI, nullable Int8/Int64 for status and IMO, NaN floats."""
+    frame = table.to_pandas()
+    frame["mmsi"] = frame["mmsi"].astype(np.int64)
+    frame["nav_status"] = frame["nav_status"].astype("Int8")
+    frame["imo"] = frame["imo"].astype("Int64")
+    frame["timestamp"] = pd.to_datetime(frame["timestamp"], utc=True)
+    return frame[list(CANONICAL_COLUMNS)]

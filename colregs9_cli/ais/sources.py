@@ -1,0 +1,250 @@
+"""Opening AIS input files: plain, gzip or zip (one data file inside), hashed while read.
+
+The compression is told by the file's first bytes, not its name. A zip must hold exactly
+one CSV (DMA ships one per zip); a zip without a CSV may hold exactly one other file (an
+NMEA log). The sha256 is of the file as stored (the .gz or .zip itself) and is computed
+while the data is read, so a multi-GB file is read from disk once. Decompression failures
+(a truncated or corrupt gzip or zip) become ``InputFileError`` naming the file.
+"""
+
+from __future__ import annotations
+
+import gzip
+import hashlib
+import io
+import threading
+import zipfile
+import zlib
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import BinaryIO
+
+from ..errors import InputFileError
+from ..progress import ProgressSink
+
+GZIP_MAGIC = b"\x1f\x8b"
+ZIP_MAGIC = b"PK\x03\x04"
+PARQUET_MAGIC = b"PAR1"
+_CHUNK = 1 << 20
+# The head read for layout detection; a DMA header line is about 300 bytes.
+HEAD_BYTES = 64 * 1024
+_DECOMPRESSION_ERRORS = (EOFError, zlib.error, gzip.BadGzipFile, zipfile.BadZipFile, OSError)
+
+
+@dataclass(frozen=True)
+class Source:
+    """An input file and how its data is stored."""
+
+    path: Path
+    compression: str  # "none", "gzip" or "zip"
+    member: str | None  # the data file inside a zip
+    size_bytes: int
+
+    @property
+    def name(self) -> str:
+        """The name used in messages: the path, plus the zip member."""
+        return f"{self.path}!{self.member}" if self.member else str(self.path)
+
+
+def inspect_source(path: Path) -> Source:
+    """Check that ``path`` is a readable, non-empty file and find its compression."""
+    path = Path(path)
+    if not path.exists():
+        raise InputFileError(f"{path}: no such file; check the path")
+    if not path.is_file():
+        raise InputFileError(f"{path}: not a file; give AIS files, not a directory")
+    size = path.stat().st_size
+    if size == 0:
+        raise InputFileError(f"{path}: the file is empty; give a file with AIS data")
+    with path.open("rb") as handle:
+        magic = handle.read(4)
+    if magic.startswith(GZIP_MAGIC):
+        return Source(path, "gzip", None, size)
+    if magic == ZIP_MAGIC:
+        return Source(path, "zip", _zip_member(path), size)
+    return Source(path, "none", None, size)
+
+
+def _zip_member(path: Path) -> str:
+    try:
+        with zipfile.ZipFile(path) as archive:
+            names = [
+                info.filename
+                for info in archive.infolist()
+                if not info.is_dir() and not info.filename.startswith("__MACOSX/")
+            ]
+    except (zipfile.BadZipFile, OSError, EOFError) as exc:
+        raise InputFileError(
+            f"{path}: truncated or corrupt zip ({exc}); download the file again"
+        ) from None
+    csvs = [n for n in names if n.lower().endswith(".csv")]
+    if len(csvs) == 1:
+        return csvs[0]
+    if len(csvs) > 1:
+        raise InputFileError(
+            f"{path}: the zip holds {len(csvs)} CSV files ({', '.join(csvs[:3])}"
+            f"{', ...' if len(csvs) > 3 else ''}); give one CSV per zip, or unzip it"
+        )
+    if len(names) == 1:
+        return names[0]
+    raise InputFileError(
+        f"{path}: the zip holds no CSV file"
+        + (f" (it holds {len(names)} other files)" if names else " (it is empty)")
+        + "; give a zip with exactly one AIS CSV"
+    )
+
+
+class _CountingReader(io.RawIOBase):
+    """A raw binary reader that hashes and reports the bytes read through it."""
+
+    def __init__(self, raw: BinaryIO, hasher: hashlib._Hash | None, progress: ProgressSink) -> None:
+        self._raw = raw
+        self._hasher = hasher
+        self._progress = progress
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buffer: memoryview | bytearray) -> int:  # type: ignore[override]
+        count = self._raw.readinto(buffer)  # type: ignore[attr-defined]
+        if count:
+            if self._hasher is not None:
+                self._hasher.update(memoryview(buffer)[:count])
+            self._progress.advance(count)
+        return count or 0
+
+    def drain(self) -> None:
+        while self.read(_CHUNK):
+            pass
+
+
+class _Silent:
+    def advance(self, amount: float = 1.0) -> None:
+        return None
+
+
+def read_head(source: Source, n_bytes: int = HEAD_BYTES) -> bytes:
+    """The first ``n_bytes`` of the decompressed data."""
+    with open_data(source) as opened:
+        return opened.stream.read(n_bytes)
+
+
+@dataclass
+class OpenedData:
+    """A decompressed binary stream, and the file's sha256 once the stream is finished."""
+
+    stream: BinaryIO
+    _counting: _CountingReader
+    _hasher: hashlib._Hash | None
+    _path: Path
+
+    def finish(self) -> str:
+        """Read what is left of the file (for the hash) and return the file's sha256."""
+        self._counting.drain()
+        if self._hasher is None:
+            return sha256_file(self._path)
+        return self._hasher.hexdigest()
+
+
+@contextmanager
+def open_data(source: Source, progress: ProgressSink | None = None) -> Iterator[OpenedData]:
+    """Open the decompressed data; decompression errors inside become ``InputFileError``.
+
+    Progress is reported in bytes of the stored file (of the zip member for a zip).
+    """
+    sink = progress if progress is not None else _Silent()
+    try:
+        with source.path.open("rb") as raw:
+            if source.compression == "zip":
+                with zipfile.ZipFile(raw) as archive, archive.open(source.member or "") as member:
+                    counting = _CountingReader(member, None, sink)  # type: ignore[arg-type]
+                    yield OpenedData(
+                        io.BufferedReader(counting, _CHUNK), counting, None, source.path
+                    )
+                return
+            hasher = hashlib.sha256()
+            counting = _CountingReader(raw, hasher, sink)
+            buffered = io.BufferedReader(counting, _CHUNK)
+            stream: BinaryIO = (
+                gzip.GzipFile(fileobj=buffered, mode="rb")  # type: ignore[assignment]
+                if source.compression == "gzip"
+                else buffered
+            )
+            yield OpenedData(stream, counting, hasher, source.path)
+    except InputFileError:
+        raise
+    except _DECOMPRESSION_ERRORS as exc:
+        raise decompression_error(source, exc) from None
+
+
+def decompression_error(source: Source, exc: BaseException) -> InputFileError:
+    kind = {"gzip": "gzip", "zip": "zip"}.get(source.compression, "file")
+    return InputFileError(
+        f"{source.name}: truncated or corrupt {kind} ({exc}); download or copy the file again"
+    )
+
+
+def sha256_file(path: Path) -> str:
+    with path.open("rb") as handle:
+        return hashlib.file_digest(handle, "sha256").hexdigest()
+
+
+def locate_non_utf8(source: Source) -> tuple[int, int, int] | None:
+    """(line, byte offset in the decompressed data, byte value) of the first non-UTF-8 byte."""
+    offset = 0
+    with open_data(source) as opened:
+        for line_no, line in enumerate(opened.stream, start=1):
+            try:
+                line.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                return line_no, offset + exc.start, line[exc.start]
+            offset += len(line)
+    return None
+
+
+class ReadaheadLimit:
+    """Keeps a background reader at most ``blocks`` reads ahead of the consumer.
+
+    pyarrow's streaming CSV reader reads its input ahead without bound on a background
+    thread: on a file that parses slower than it reads, the whole file ends up in memory.
+    Wrapped in this, a read made off the consumer's thread waits until the consumer has
+    taken enough batches (``consumed``), so memory stays at a few blocks. Reads on the
+    consumer's own thread never wait (that would deadlock).
+    """
+
+    def __init__(self, stream: BinaryIO, blocks: int) -> None:
+        self._stream = stream
+        self._blocks = blocks
+        self._reads = 0
+        self._consumed = 0
+        self._consumer = threading.get_ident()
+        self._changed = threading.Condition()
+        self.closed = False
+
+    def readable(self) -> bool:
+        return True
+
+    def read(self, size: int = -1) -> bytes:
+        if threading.get_ident() != self._consumer:
+            with self._changed:
+                self._changed.wait_for(lambda: self._reads - self._consumed < self._blocks)
+        data = self._stream.read(size)
+        with self._changed:
+            self._reads += 1
+        return data
+
+    def consumed(self) -> None:
+        with self._changed:
+            self._consumed += 1
+            self._changed.notify_all()
+
+    def release(self) -> None:
+        """Let a waiting reader go (the consumer stopped early)."""
+        with self._changed:
+            self._consumed = 1 << 60
+            self._changed.notify_all()
+
+    def close(self) -> None:
+        self.closed = True

@@ -1,0 +1,413 @@
+"""Charts: depth areas, land and hazards in the run's local frame, and the navigable water.
+
+Geometry convention: every shapely geometry of a ``Chart`` is in the local frame of
+``colregs9_cli.geo.LocalFrame`` with **x = east_m and y = north_m**. Functions that take
+positions take them as ``(north_m, east_m)``, like the rest of the package.
+
+Sources
+-------
+- S-57 ENC cells (``.000``) through pyogrio and GDAL's S57 driver. The driver is opened with
+  ``UPDATES=APPLY`` (update files ``.001``, ``.002``, … lying beside the base cell are applied in
+  order), ``SPLIT_MULTIPOINT=ON`` and ``ADD_SOUNDG_DEPTH=ON``; these are passed as dataset open
+  options, so no global ``OGR_S57_OPTIONS`` is needed.
+- GeoJSON (``.geojson``, ``.json``) and GeoPackage (``.gpkg``) files with the S-57 attribute
+  names: the object class in a column ``OBJL`` (the acronym such as ``"DEPARE"`` or its numeric
+  S-57 code such as 42), ``DRVAL1`` and optionally ``DRVAL2`` and ``VALSOU``.
+
+Object classes used: DEPARE and DRGARE (dredged areas count as depth areas), LNDARE (land),
+PONTON, HULKES, FLODOC and DRYDOC areas (structures that cut holes in the depth areas; they
+are treated like land), and OBSTRN, WRECKS and UWTROC as point hazards. A hazard, and a land
+area charted as a point or line, is buffered by ``HAZARD_RADIUS_M``. A hazard blocks a
+vessel when its sounding ``VALSOU`` is shallower than draught + UKC, or when it has no
+sounding (unknown depth is treated as dangerous, as ECDIS does).
+
+Navigable water for draught T is the union of depth areas with ``DRVAL1 >= T + UKC``, minus
+land and structures, minus the blocking hazards. Coverage (the charted extent) is the union
+of every depth area, land and structure: a position outside it is "unknown", never "deep".
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from enum import StrEnum
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyogrio
+import shapely
+from numpy.typing import ArrayLike, NDArray
+from pyogrio.errors import DataLayerError, DataSourceError, FieldError, GeometryError
+from pyproj import CRS, Transformer
+from pyproj.exceptions import CRSError
+
+from .errors import ChartError, ParameterError
+from .geo import LocalFrame
+
+HAZARD_RADIUS_M = 10.0
+S57_OPEN_OPTIONS = {"UPDATES": "APPLY", "SPLIT_MULTIPOINT": "ON", "ADD_SOUNDG_DEPTH": "ON"}
+S57_SUFFIXES = (".000",)
+VECTOR_SUFFIXES = (".geojson", ".json", ".gpkg")
+
+
+class ChartLayer(StrEnum):
+    """The role a chart feature plays."""
+
+    DEPARE = "DEPARE"
+    DRGARE = "DRGARE"
+    LNDARE = "LNDARE"
+    HAZARD = "HAZARD"
+
+
+# S-57 object class acronym → (numeric code, role).
+_OBJECT_CLASSES: dict[str, tuple[int, ChartLayer]] = {
+    "DEPARE": (42, ChartLayer.DEPARE),
+    "DRGARE": (46, ChartLayer.DRGARE),
+    "LNDARE": (71, ChartLayer.LNDARE),
+    "PONTON": (95, ChartLayer.LNDARE),
+    "HULKES": (65, ChartLayer.LNDARE),
+    "FLODOC": (57, ChartLayer.LNDARE),
+    "DRYDOC": (47, ChartLayer.LNDARE),
+    "OBSTRN": (86, ChartLayer.HAZARD),
+    "WRECKS": (159, ChartLayer.HAZARD),
+    "UWTROC": (153, ChartLayer.HAZARD),
+}
+_ACRONYM_BY_CODE = {code: name for name, (code, _) in _OBJECT_CLASSES.items()}
+_POLYGONAL = (shapely.GeometryType.POLYGON, shapely.GeometryType.MULTIPOLYGON)
+
+
+@dataclass(frozen=True)
+class WaterIndex:
+    """Navigable water for one (draught, UKC), prepared, with its prepared boundary."""
+
+    water: Any
+    boundary: Any
+
+
+@dataclass(frozen=True)
+class Chart:
+    """Depth areas, land and hazards of one or more charts, in the local frame (x east, y north).
+
+    ``hazard_areas``/``hazard_depth_m`` hold each buffered hazard and its sounding (NaN when
+    unknown); ``hazards`` is their union. A chart built without the per-hazard arrays treats
+    every hazard as blocking.
+    """
+
+    frame: LocalFrame
+    depth_areas: NDArray[np.object_]
+    drval1_m: NDArray[np.float64]
+    drval2_m: NDArray[np.float64]
+    kinds: NDArray[np.object_]
+    land: Any
+    hazards: Any
+    coverage: Any
+    sources: tuple[Path, ...] = ()
+    layer_counts: Mapping[str, int] = field(default_factory=dict)
+    hazard_areas: NDArray[np.object_] = field(default_factory=lambda: np.empty(0, dtype=object))
+    hazard_depth_m: NDArray[np.float64] = field(default_factory=lambda: np.empty(0))
+    _water: dict[tuple[float, float], WaterIndex] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
+
+    def __post_init__(self) -> None:
+        shapely.prepare(self.coverage)
+
+    def water_index(self, draught_m: float, ukc_m: float = 0.0) -> WaterIndex:
+        """The prepared navigable water and its boundary, built once per (draught, UKC)."""
+        if not (np.isfinite(draught_m) and draught_m >= 0.0):
+            raise ParameterError(f"draught {draught_m} m is negative; give a draught >= 0")
+        if not (np.isfinite(ukc_m) and ukc_m >= 0.0):
+            raise ParameterError(f"under-keel clearance {ukc_m} m is negative; give a UKC >= 0")
+        key = (float(draught_m), float(ukc_m))
+        if key not in self._water:
+            required_m = draught_m + ukc_m
+            deep = shapely.union_all(self.depth_areas[self.drval1_m >= required_m])
+            water = shapely.difference(deep, self.land)
+            blocking = self._blocking_hazards(required_m)
+            if not shapely.is_empty(blocking):
+                water = shapely.difference(water, blocking)
+            boundary = shapely.boundary(water)
+            shapely.prepare(water)
+            shapely.prepare(boundary)
+            self._water[key] = WaterIndex(water, boundary)
+        return self._water[key]
+
+    def navigable_water(self, draught_m: float, ukc_m: float = 0.0) -> Any:
+        """Water at least ``draught_m + ukc_m`` deep, minus land and blocking hazards (prepared)."""
+        return self.water_index(draught_m, ukc_m).water
+
+    def covers(self, north_m: ArrayLike, east_m: ArrayLike) -> NDArray[np.bool_]:
+        """True where a local-frame position lies inside the charted extent (boundary included)."""
+        return np.asarray(
+            shapely.intersects_xy(
+                self.coverage, np.asarray(east_m, dtype=float), np.asarray(north_m, dtype=float)
+            ),
+            dtype=bool,
+        )
+
+    def navigable_area_km2(self, draught_m: float, ukc_m: float = 0.0) -> float:
+        return float(shapely.area(self.navigable_water(draught_m, ukc_m))) / 1e6
+
+    def depth_range_m(self) -> tuple[float, float]:
+        """The smallest and largest DRVAL1 over the depth areas."""
+        return float(np.nanmin(self.drval1_m)), float(np.nanmax(self.drval1_m))
+
+    def bounds_wgs84(self) -> tuple[float, float, float, float]:
+        """(lat_min, lat_max, lon_min, lon_max) of the charted extent."""
+
+        def east_north_to_lonlat(xy: NDArray[np.float64]) -> NDArray[np.float64]:
+            lat_deg, lon_deg = self.frame.to_geodetic(xy[:, 1], xy[:, 0])
+            return np.column_stack([lon_deg, lat_deg])
+
+        lon_min, lat_min, lon_max, lat_max = shapely.bounds(
+            shapely.transform(self.coverage, east_north_to_lonlat)
+        )
+        return float(lat_min), float(lat_max), float(lon_min), float(lon_max)
+
+    def _blocking_hazards(self, required_m: float) -> Any:
+        if len(self.hazard_areas) == 0:
+            return self.hazards
+        blocking = np.isnan(self.hazard_depth_m) | (self.hazard_depth_m < required_m)
+        return shapely.union_all(self.hazard_areas[blocking])
+
+
+@dataclass(frozen=True)
+class _Features:
+    """One file's features in WGS84 (x lon, y lat), before projection."""
+
+    path: Path
+    geometries: NDArray[np.object_]
+    object_class: NDArray[np.object_]
+    drval1_m: NDArray[np.float64]
+    drval2_m: NDArray[np.float64]
+    valsou_m: NDArray[np.float64]
+
+
+def _numeric(values: Any, path: Path, column: str) -> NDArray[np.float64]:
+    try:
+        return np.asarray(
+            [np.nan if v is None or v == "" else float(v) for v in values], dtype=float
+        )
+    except (TypeError, ValueError):
+        bad = next(v for v in values if not _is_number(v))
+        raise ChartError(
+            f"{path}: column {column} has the value {bad!r}, which is not a depth in metres; "
+            "fix the file"
+        ) from None
+
+
+def _is_number(value: Any) -> bool:
+    try:
+        float(value)
+    except (TypeError, ValueError):
+        return value is None or value == ""
+    return True
+
+
+def _object_class(value: Any, path: Path) -> str | None:
+    """The acronym for an OBJL value (acronym or numeric code); None for classes not used."""
+    if value is None:
+        return None
+    text = str(value).strip().upper()
+    if text.isdigit():
+        return _ACRONYM_BY_CODE.get(int(text))
+    return text if text in _OBJECT_CLASSES else None
+
+
+def _read_layer(path: Path, layer: str | int, **options: str) -> tuple[dict[str, Any], Any]:
+    try:
+        meta, _, wkb, field_data = pyogrio.raw.read(path, layer=layer, **options)
+    except (DataSourceError, DataLayerError, FieldError, GeometryError, RuntimeError) as exc:
+        raise ChartError(
+            f"{path}: cannot read layer {layer} ({_first_line(exc)}); give an S-57 .000, "
+            "GeoJSON or GeoPackage chart"
+        ) from None
+    columns = dict(zip(meta["fields"], field_data, strict=True))
+    geometries = shapely.from_wkb(wkb) if wkb is not None else np.empty(0, dtype=object)
+    return {"crs": meta.get("crs"), "columns": columns}, geometries
+
+
+def _first_line(exc: BaseException) -> str:
+    return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+
+
+def _list_layers(path: Path) -> list[str]:
+    try:
+        return [str(name) for name, _ in pyogrio.list_layers(path)]
+    except (DataSourceError, DataLayerError, RuntimeError) as exc:
+        raise ChartError(
+            f"{path}: not a chart GDAL can open ({_first_line(exc)}); give an S-57 .000, "
+            "GeoJSON or GeoPackage chart"
+        ) from None
+
+
+def _read_s57(path: Path) -> _Features:
+    layers = set(_list_layers(path))
+    parts: list[tuple[NDArray[np.object_], str, Mapping[str, Any]]] = []
+    for name in _OBJECT_CLASSES:
+        if name in layers:
+            meta, geometries = _read_layer(path, name, **S57_OPEN_OPTIONS)
+            parts.append((geometries, name, meta["columns"]))
+    return _assemble(path, parts)
+
+
+def _read_vector(path: Path) -> _Features:
+    parts: list[tuple[NDArray[np.object_], str | NDArray[np.object_], Mapping[str, Any]]] = []
+    for layer in _list_layers(path):
+        meta, geometries = _read_layer(path, layer)
+        columns = meta["columns"]
+        if len(geometries) == 0:
+            continue
+        for column in ("OBJL", "DRVAL1"):
+            if column not in columns:
+                raise ChartError(
+                    f"{path}: layer {layer} has no column {column}; a GeoJSON/GeoPackage chart "
+                    "needs OBJL (S-57 object class, e.g. DEPARE) and DRVAL1 (shallowest depth, m)"
+                )
+        geometries = _to_wgs84(geometries, meta["crs"], path)
+        classes = np.asarray([_object_class(v, path) for v in columns["OBJL"]], dtype=object)
+        parts.append((geometries, classes, columns))
+    return _assemble(path, parts)
+
+
+def _to_wgs84(geometries: NDArray[np.object_], crs: str | None, path: Path) -> Any:
+    if crs is None:
+        return geometries
+    try:
+        source = CRS.from_user_input(crs)
+    except CRSError:
+        raise ChartError(f"{path}: unknown coordinate reference system {crs!r}") from None
+    if source.equals(CRS.from_epsg(4326), ignore_axis_order=True):
+        return geometries
+    transformer = Transformer.from_crs(source, "EPSG:4326", always_xy=True)
+    return shapely.transform(
+        geometries, lambda xy: np.column_stack(transformer.transform(xy[:, 0], xy[:, 1]))
+    )
+
+
+def _assemble(
+    path: Path,
+    parts: Sequence[tuple[NDArray[np.object_], str | NDArray[np.object_], Mapping[str, Any]]],
+) -> _Features:
+    geometries, classes, drval1, drval2, valsou = [], [], [], [], []
+    for part_geometries, part_class, columns in parts:
+        n = len(part_geometries)
+        geometries.append(part_geometries)
+        classes.append(
+            np.full(n, part_class, dtype=object) if isinstance(part_class, str) else part_class
+        )
+        for out, column in ((drval1, "DRVAL1"), (drval2, "DRVAL2"), (valsou, "VALSOU")):
+            values = columns.get(column)
+            out.append(np.full(n, np.nan) if values is None else _numeric(values, path, column))
+    if not geometries:
+        return _Features(path, *(np.empty(0, dtype=object),) * 2, *(np.empty(0),) * 3)
+    features = _Features(
+        path,
+        np.concatenate(geometries),
+        np.concatenate(classes),
+        np.concatenate(drval1),
+        np.concatenate(drval2),
+        np.concatenate(valsou),
+    )
+    keep = ~shapely.is_missing(features.geometries) & (features.object_class != None)  # noqa: E711
+    return _Features(
+        path,
+        features.geometries[keep],
+        features.object_class[keep],
+        features.drval1_m[keep],
+        features.drval2_m[keep],
+        features.valsou_m[keep],
+    )
+
+
+def _read_features(path: Path) -> _Features:
+    path = Path(path)
+    if not path.is_file():
+        raise ChartError(f"{path}: no such chart file; check the path")
+    suffix = path.suffix.lower()
+    if suffix in S57_SUFFIXES:
+        features = _read_s57(path)
+    elif suffix in VECTOR_SUFFIXES:
+        features = _read_vector(path)
+    else:
+        raise ChartError(
+            f"{path}: unknown chart type {suffix or '(no suffix)'!r}; give an S-57 base cell "
+            "(.000), a GeoJSON (.geojson) or a GeoPackage (.gpkg)"
+        )
+    depth = np.isin(features.object_class, ["DEPARE", "DRGARE"])
+    polygonal = np.isin(shapely.get_type_id(features.geometries), _POLYGONAL)
+    if not (depth & polygonal).any():
+        raise ChartError(
+            f"{path}: the chart has no depth areas (DEPARE or DRGARE polygons); give a chart "
+            "with depth information"
+        )
+    return features
+
+
+def chart_bounds_wgs84(paths: Sequence[Path]) -> tuple[float, float, float, float]:
+    """(lat_min, lat_max, lon_min, lon_max) of the charts' features."""
+    return _bounds([_read_features(Path(p)) for p in paths])
+
+
+def _bounds(features: Sequence[_Features]) -> tuple[float, float, float, float]:
+    lon_min, lat_min, lon_max, lat_max = shapely.total_bounds(
+        np.concatenate([f.geometries for f in features])
+    )
+    return float(lat_min), float(lat_max), float(lon_min), float(lon_max)
+
+
+def _project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
+    def lonlat_to_east_north(xy: NDArray[np.float64]) -> NDArray[np.float64]:
+        north_m, east_m = frame.to_local(xy[:, 1], xy[:, 0])
+        return np.column_stack([east_m, north_m])
+
+    projected = shapely.transform(geometries, lonlat_to_east_north)
+    invalid = ~shapely.is_valid(projected)
+    if invalid.any():
+        projected[invalid] = shapely.make_valid(projected[invalid])
+    return projected
+
+
+def load_chart(paths: Sequence[Path], frame: LocalFrame | None = None) -> Chart:
+    """Read and merge charts, project them into ``frame`` (default: centred on their extent)."""
+    if not paths:
+        raise ChartError("no chart given; give at least one chart file")
+    features = [_read_features(Path(p)) for p in paths]
+    if frame is None:
+        frame = LocalFrame.centred_on(*_bounds(features))
+    geometries = _project(np.concatenate([f.geometries for f in features]), frame)
+    object_class = np.concatenate([f.object_class for f in features])
+    drval1 = np.concatenate([f.drval1_m for f in features])
+    drval2 = np.concatenate([f.drval2_m for f in features])
+    valsou = np.concatenate([f.valsou_m for f in features])
+    role = np.asarray([_OBJECT_CLASSES[c][1] for c in object_class], dtype=object)
+    polygonal = np.isin(shapely.get_type_id(geometries), _POLYGONAL)
+
+    depth = np.isin(role, [ChartLayer.DEPARE, ChartLayer.DRGARE]) & polygonal
+    land_areas = (role == ChartLayer.LNDARE) & polygonal
+    # Land charted as a point or line (an islet, a pier) is a hazard at any depth.
+    small_land = (role == ChartLayer.LNDARE) & ~polygonal
+    hazard = (role == ChartLayer.HAZARD) | small_land
+    hazard_depth = np.where(small_land, -np.inf, valsou)[hazard]
+    hazard_areas = shapely.buffer(geometries[hazard], HAZARD_RADIUS_M)
+
+    land = shapely.union_all(geometries[land_areas])
+    coverage = shapely.union_all(np.concatenate([geometries[depth], [land]]))
+    counts: dict[str, int] = {}
+    for name in object_class:
+        counts[str(name)] = counts.get(str(name), 0) + 1
+    return Chart(
+        frame=frame,
+        depth_areas=geometries[depth],
+        drval1_m=drval1[depth],
+        drval2_m=drval2[depth],
+        kinds=role[depth],
+        land=land,
+        hazards=shapely.union_all(hazard_areas),
+        coverage=coverage,
+        sources=tuple(Path(p) for p in paths),
+        layer_counts={name: counts[name] for name in _OBJECT_CLASSES if name in counts},
+        hazard_areas=hazard_areas,
+        hazard_depth_m=hazard_depth,
+    )

@@ -1,0 +1,88 @@
+"""``colregs9 chart``: a chart's summary and, for a draught, its navigable water and a plot."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+
+from .chart import Chart, load_chart
+from .errors import ParameterError
+from .progress import progress_bar, progress_enabled
+from .report.atomic import save_figure
+from .report.chart_plot import draw_chart
+
+DEFAULT_REPORTS_DIR = Path("reports")
+
+
+@dataclass(frozen=True)
+class ChartSummary:
+    chart: Chart
+    navigable_area_km2: float | None
+    plot_path: Path | None
+    text: str
+
+
+def _check_depth(name: str, value: float | None) -> None:
+    if value is not None and not value >= 0.0:
+        raise ParameterError(f"--{name} {value} m is negative; give a value >= 0")
+
+
+def format_chart_summary(chart: Chart) -> str:
+    lat_min, lat_max, lon_min, lon_max = chart.bounds_wgs84()
+    depth_min, depth_max = chart.depth_range_m()
+    lines = ["Charts: " + ", ".join(str(p) for p in chart.sources), "Layers (features):"]
+    lines += [f"  {name:<7} {count:>6}" for name, count in chart.layer_counts.items()]
+    lines += [
+        f"Depth areas: {len(chart.depth_areas)}, DRVAL1 {depth_min:g} .. {depth_max:g} m",
+        f"Extent: lat {lat_min:.5f} .. {lat_max:.5f}, lon {lon_min:.5f} .. {lon_max:.5f}",
+        f"Charted area: {chart.coverage.area / 1e6:.3f} km²",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def summarise_chart(
+    paths: Sequence[Path],
+    draught_m: float | None = None,
+    ukc_m: float = 0.0,
+    out: Path | None = None,
+    quiet: bool = False,
+) -> ChartSummary:
+    """Load the charts and summarise them; with a draught, add its navigable area and a plot.
+
+    The plot goes to ``out`` (default ``reports/chart-<first chart's stem>.png``).
+    """
+    _check_depth("draught", draught_m)
+    _check_depth("ukc", ukc_m)
+    with progress_bar("Reading charts", 1, progress_enabled(quiet)) as bar:
+        chart = load_chart(paths)
+        bar.advance()
+    text = format_chart_summary(chart)
+    if draught_m is None:
+        return ChartSummary(chart, None, None, text)
+    area_km2 = chart.navigable_area_km2(draught_m, ukc_m)
+    plot_path = DEFAULT_REPORTS_DIR / f"chart-{Path(paths[0]).stem}.png" if out is None else out
+    figure, ax = plt.subplots(figsize=(8, 8), layout="constrained")
+    try:
+        depths = draw_chart(ax, chart, draught_m, ukc_m)
+        figure.colorbar(depths, ax=ax, label="DRVAL1, shallowest depth (m)", shrink=0.7)
+        ax.set_xlabel("east (m)")
+        ax.set_ylabel("north (m)")
+        ax.set_title(
+            f"{Path(paths[0]).name}: navigable water for draught {draught_m:g} m "
+            f"+ UKC {ukc_m:g} m ({area_km2:.3f} km²)",
+            fontsize="medium",
+        )
+        ax.legend(loc="lower right", fontsize="small")
+        save_figure(plot_path, figure, dpi=150)
+    finally:
+        plt.close(figure)
+    text += f"Navigable water for draught {draught_m:g} m + UKC {ukc_m:g} m: {area_km2:.3f} km²\n"
+    text += f"Plot: {plot_path}\n"
+    return ChartSummary(chart, area_km2, plot_path, text)

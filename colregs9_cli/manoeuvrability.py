@@ -1,0 +1,475 @@
+"""The paper's manoeuvrability estimator (section "Assessing vessel manoeuvrability").
+
+1. Rate of swing (eq. ``rate_of_swing``): ``δ_swing = 360 / (2π r_turn)`` deg/m, from the 14
+   reference vessels of the paper's Table "Overview of vessels used for calculation of rate of
+   swing" (package data ``data/turning_circles.csv``), scaled (eq. ``rate_of_swing_scaled``) to
+   ``δ' = α·δ_swing`` with α ∈ [0, 1].
+2. Turning arcs (eqs. ``pprime``, ``p'_body``, ``psi'``, ``r``): with ``r = 1/δ'`` (δ' in rad/m)
+   and path length ``l_k = v·k·Δt`` for k = 1 … horizon/Δt, the heading change is
+   ``ψ'_k = l_k·δ'`` and the body-frame offset ``r·[sin ψ', ±(1 − cos ψ')]`` (forward,
+   starboard; + for the clockwise, starboard turn). It is rotated by the course into
+   (north, east). k = 0, the present position, is not projected: the arcs are the future
+   positions, as in the paper. A vessel at rest (v = 0) projects every k onto its present
+   position, so the estimator then checks the ellipse where she lies.
+3. Comfort zones (the paper's ellipse, with DESIGN §5's correction of its typo): an ellipse
+   with semi-axis ``a = domain_length_factor·L`` along the heading at that point and
+   ``b = domain_breadth_factor·B`` across it, as a 32-vertex polygon inscribed in the ellipse.
+4. A projected position is restricted when its ellipse is not properly inside the navigable
+   water: it touches or crosses the boundary of the feasible depth contour, in the paper's
+   words. The verdict over both arcs follows a ``RestrictionPolicy``.
+
+Unknown chart coverage is three-valued, never "clear": no chart, or the target's present
+position outside the chart, gives ``UNKNOWN``. A projected position outside the chart's
+coverage may be either red or blue; the verdict is ``RESTRICTED`` when the policy holds on
+the covered red positions alone, ``NOT_RESTRICTED`` when it fails even if every uncovered
+position were red, and ``UNKNOWN`` in between.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+from importlib import resources
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+import shapely
+from numpy.typing import ArrayLike, NDArray
+
+from .config import dataclass_from_table
+from .errors import ParameterError
+
+if TYPE_CHECKING:
+    from .chart import Chart, WaterIndex
+
+ELLIPSE_VERTICES = 32
+# Consecutive projected positions tested together by the coarse distance filter.
+_CHUNK_POINTS = 12
+
+
+class SwingModel(StrEnum):
+    """How a target's rate of swing δ_swing is chosen (before scaling by α)."""
+
+    FIXED = "fixed"
+    NEAREST_LENGTH = "nearest-length"
+    LOWER_BOUND = "lower-bound"
+
+
+class RestrictionPolicy(StrEnum):
+    """When the red positions on the two arcs make the target restricted (event d3)."""
+
+    ANY = "any"
+    BOTH_SIDES = "both-sides"
+    STARBOARD = "starboard"
+
+
+class Restriction(StrEnum):
+    """The estimator's verdict; ``UNKNOWN`` where the chart cannot tell."""
+
+    RESTRICTED = "true"
+    NOT_RESTRICTED = "false"
+    UNKNOWN = "unknown"
+
+
+class Arc(StrEnum):
+    CLOCKWISE = "cw"
+    COUNTER_CLOCKWISE = "ccw"
+
+
+def _positive(name: str, value: float, unit: str) -> None:
+    if not (math.isfinite(value) and value > 0.0):
+        raise ParameterError(f"{name} {value} {unit} is not positive; give a value > 0")
+
+
+@dataclass(frozen=True)
+class ManoeuvrabilityParams:
+    """Parameters of the estimator; defaults are the paper's Table "Simulation parameters".
+
+    ``swing_deg_per_m`` is the rate of swing of the ``fixed`` model (the paper: 0.2 deg/m);
+    ``horizon_s`` is the look-ahead (the paper's TCPA_act, 180 s) at ``step_s``.
+    """
+
+    swing_model: SwingModel = SwingModel.FIXED
+    swing_deg_per_m: float = 0.2
+    alpha: float = 0.4
+    horizon_s: float = 180.0
+    step_s: float = 1.0
+    domain_length_factor: float = 1.0
+    domain_breadth_factor: float = 1.5
+    ukc_m: float = 0.0
+    policy: RestrictionPolicy = RestrictionPolicy.ANY
+
+    def __post_init__(self) -> None:
+        try:
+            object.__setattr__(self, "swing_model", SwingModel(self.swing_model))
+            object.__setattr__(self, "policy", RestrictionPolicy(self.policy))
+        except ValueError as exc:
+            raise ParameterError(
+                f"{exc}; swing_model is one of {', '.join(SwingModel)} and policy one of "
+                f"{', '.join(RestrictionPolicy)}"
+            ) from None
+        if not (math.isfinite(self.alpha) and 0.0 <= self.alpha <= 1.0):
+            raise ParameterError(
+                f"alpha {self.alpha} is outside [0, 1]; the rate of swing scale α must be "
+                "between 0 and 1 (the paper uses 0.4)"
+            )
+        _positive("swing_deg_per_m", self.swing_deg_per_m, "deg/m")
+        _positive("horizon_s", self.horizon_s, "s")
+        _positive("step_s", self.step_s, "s")
+        _positive("domain_length_factor", self.domain_length_factor, "")
+        _positive("domain_breadth_factor", self.domain_breadth_factor, "")
+        if self.step_s > self.horizon_s:
+            raise ParameterError(
+                f"step_s {self.step_s} s is longer than horizon_s {self.horizon_s} s; "
+                "give a step no longer than the horizon"
+            )
+        if not (math.isfinite(self.ukc_m) and self.ukc_m >= 0.0):
+            raise ParameterError(
+                f"ukc_m {self.ukc_m} m is negative; the under-keel clearance must be >= 0"
+            )
+
+    @property
+    def steps(self) -> int:
+        """Projected positions per arc: horizon / step, rounded."""
+        return max(1, round(self.horizon_s / self.step_s))
+
+    @classmethod
+    def from_table(cls, table: dict[str, Any], where: str) -> ManoeuvrabilityParams:
+        """From a ``[manoeuvrability]`` TOML table; unknown keys and bad values are errors."""
+        return dataclass_from_table(cls, table, where)
+
+
+def rate_of_swing_deg_per_m(turn_radius_m: ArrayLike) -> NDArray[np.float64]:
+    """The paper's eq. ``rate_of_swing``: heading change per metre on the turning circle."""
+    return 360.0 / (2.0 * np.pi * np.asarray(turn_radius_m, dtype=float))
+
+
+@functools.cache
+def _reference_table() -> pd.DataFrame:
+    with resources.files("colregs9_cli").joinpath("data/turning_circles.csv").open("rb") as f:
+        table = pd.read_csv(f)
+    table["rate_of_swing_deg_per_m"] = rate_of_swing_deg_per_m(table["turn_radius_m"])
+    return table
+
+
+@functools.cache
+def _reference_lengths_and_rates() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    table = _reference_table()
+    return table["length_m"].to_numpy(), table["rate_of_swing_deg_per_m"].to_numpy()
+
+
+def reference_vessels() -> pd.DataFrame:
+    """The paper's 14 reference vessels with their ``rate_of_swing_deg_per_m``."""
+    return _reference_table().copy()
+
+
+def target_rate_of_swing_deg_per_m(length_m: float | None, params: ManoeuvrabilityParams) -> float:
+    """δ_swing for a target, before the α scaling of the paper's eq. ``rate_of_swing_scaled``.
+
+    - ``fixed``: ``params.swing_deg_per_m``; the paper's simulations use 0.2 deg/m.
+    - ``nearest-length``: the reference vessel closest in length, the paper's idea of
+      "comparing against the turning circles of vessels of similar dimensions". Ties go to
+      the slower-turning vessel; an unknown length falls back to ``lower-bound``.
+    - ``lower-bound``: the table's minimum, 360/(2π·740.8 m) ≈ 0.077 deg/m (the 363.6 m bulk
+      carrier). The paper reads "≈ 0.1 deg/m" off its figure as the lower bound; the table's
+      exact minimum is used here.
+    """
+    if params.swing_model is SwingModel.FIXED:
+        return params.swing_deg_per_m
+    lengths, rates = _reference_lengths_and_rates()
+    if params.swing_model is SwingModel.LOWER_BOUND or length_m is None or not np.isfinite(length_m):
+        return float(rates.min())
+    gap = np.abs(lengths - length_m)
+    nearest = gap == gap.min()
+    return float(rates[nearest].min())
+
+
+@dataclass(frozen=True)
+class TurningArcs:
+    """Projected positions: the clockwise arc (k = 1…n) then the counter-clockwise arc."""
+
+    arc: NDArray[np.str_]
+    step: NDArray[np.int64]
+    path_length_m: NDArray[np.float64]
+    north_m: NDArray[np.float64]
+    east_m: NDArray[np.float64]
+    heading_deg: NDArray[np.float64]
+    turn_radius_m: float
+
+
+def turning_arcs(
+    north_m: float,
+    east_m: float,
+    course_deg: float,
+    speed_mps: float,
+    rate_of_swing_deg_per_m: float,
+    horizon_s: float,
+    step_s: float,
+) -> TurningArcs:
+    """Both arcs from (p, ψ, v) at the scaled rate ``δ'`` (deg/m) over the horizon.
+
+    A rate of 0 (α = 0) means an infinite radius: both arcs run straight ahead.
+    """
+    steps = max(1, round(horizon_s / step_s))
+    k = np.arange(1, steps + 1)
+    path_m = speed_mps * step_s * k
+    rate_rad_per_m = math.radians(rate_of_swing_deg_per_m)
+    if rate_rad_per_m > 0.0:
+        radius_m = 1.0 / rate_rad_per_m
+        turn_rad = path_m * rate_rad_per_m
+        forward_m = radius_m * np.sin(turn_rad)
+        starboard_m = radius_m * (1.0 - np.cos(turn_rad))
+    else:
+        radius_m = math.inf
+        turn_rad = np.zeros_like(path_m)
+        forward_m = path_m
+        starboard_m = np.zeros_like(path_m)
+    forward_m = np.concatenate([forward_m, forward_m])
+    starboard_m = np.concatenate([starboard_m, -starboard_m])
+    course_rad = math.radians(course_deg)
+    cos_c, sin_c = math.cos(course_rad), math.sin(course_rad)
+    turn_deg = np.degrees(turn_rad)
+    return TurningArcs(
+        arc=np.repeat(np.array([Arc.CLOCKWISE.value, Arc.COUNTER_CLOCKWISE.value]), steps),
+        step=np.concatenate([k, k]),
+        path_length_m=np.concatenate([path_m, path_m]),
+        north_m=north_m + forward_m * cos_c - starboard_m * sin_c,
+        east_m=east_m + forward_m * sin_c + starboard_m * cos_c,
+        heading_deg=np.mod(course_deg + np.concatenate([turn_deg, -turn_deg]), 360.0),
+        turn_radius_m=radius_m,
+    )
+
+
+def _unit_ellipse(a_m: float, b_m: float, n_vertices: int) -> tuple[NDArray, NDArray]:
+    """Body-frame (forward, starboard) vertices, closed, inscribed in the ellipse."""
+    t_rad = np.linspace(0.0, 2.0 * np.pi, n_vertices + 1)
+    forward_m, starboard_m = a_m * np.cos(t_rad), b_m * np.sin(t_rad)
+    forward_m[-1], starboard_m[-1] = forward_m[0], starboard_m[0]
+    return forward_m, starboard_m
+
+
+def ellipse_polygons(
+    north_m: ArrayLike,
+    east_m: ArrayLike,
+    heading_deg: ArrayLike,
+    a_m: float,
+    b_m: float,
+    n_vertices: int = ELLIPSE_VERTICES,
+) -> NDArray[np.object_]:
+    """Ellipses (semi-axis ``a_m`` along the heading, ``b_m`` across) as shapely polygons.
+
+    Coordinates are built with numpy and turned into polygons in one shapely call; x is east.
+    """
+    north = np.atleast_1d(np.asarray(north_m, dtype=float))[:, None]
+    east = np.atleast_1d(np.asarray(east_m, dtype=float))[:, None]
+    heading_rad = np.radians(np.atleast_1d(np.asarray(heading_deg, dtype=float)))[:, None]
+    forward_m, starboard_m = _unit_ellipse(a_m, b_m, n_vertices)
+    cos_h, sin_h = np.cos(heading_rad), np.sin(heading_rad)
+    vertex_north = north + forward_m * cos_h - starboard_m * sin_h
+    vertex_east = east + forward_m * sin_h + starboard_m * cos_h
+    return shapely.polygons(np.stack([vertex_east, vertex_north], axis=-1))
+
+
+@functools.cache
+def _ellipse_radii(a_m: float, b_m: float, n_vertices: int) -> tuple[float, float]:
+    """(inner, outer) radius of the polygon: it holds the inner disc and lies in the outer one."""
+    forward_m, starboard_m = _unit_ellipse(a_m, b_m, n_vertices)
+    d_fwd, d_stbd = np.diff(forward_m), np.diff(starboard_m)
+    cross = np.abs(forward_m[:-1] * d_stbd - starboard_m[:-1] * d_fwd)
+    inner_m = float(np.min(cross / np.hypot(d_fwd, d_stbd)))
+    # A hair inside, so that rounding never calls a clear polygon restricted.
+    return inner_m * (1.0 - 1e-9), max(a_m, b_m) * (1.0 + 1e-9)
+
+
+def restricted_flags(
+    index: WaterIndex,
+    north_m: NDArray[np.float64],
+    east_m: NDArray[np.float64],
+    heading_deg: NDArray[np.float64],
+    a_m: float,
+    b_m: float,
+    n_vertices: int = ELLIPSE_VERTICES,
+) -> NDArray[np.bool_]:
+    """True where the ellipse at a position is not properly inside the navigable water.
+
+    Exact for the polygonal ellipses, and vectorised: a position whose centre is in the water
+    and farther than the ellipse's outer radius from the water's boundary is clear; one whose
+    centre is outside, or within the inner radius of the boundary, is restricted. Those are
+    decided by prepared distance queries, first per run of ``_CHUNK_POINTS`` consecutive
+    positions, then per position; only the rest build their ellipses and are tested with one
+    ``shapely.contains_properly`` call.
+    """
+    n = len(north_m)
+    inside = np.asarray(shapely.contains_xy(index.water, east_m, north_m), dtype=bool)
+    if n == 0 or shapely.is_empty(index.boundary):
+        return ~inside
+    inner_m, outer_m = _ellipse_radii(a_m, b_m, n_vertices)
+    starts = np.arange(0, n, _CHUNK_POINTS)
+    chunk = np.arange(n) // _CHUNK_POINTS
+    counts = np.diff(np.append(starts, n))
+    centre_east = np.add.reduceat(east_m, starts) / counts
+    centre_north = np.add.reduceat(north_m, starts) / counts
+    spread_m = np.maximum.reduceat(
+        np.hypot(east_m - centre_east[chunk], north_m - centre_north[chunk]), starts
+    )
+    far_chunks = ~shapely.dwithin(
+        index.boundary, shapely.points(centre_east, centre_north), spread_m + outer_m
+    )
+    undecided = ~far_chunks[chunk]
+    near_idx = np.flatnonzero(undecided)
+    points = shapely.points(east_m[near_idx], north_m[near_idx])
+    far = ~shapely.dwithin(index.boundary, points, outer_m)
+    undecided[near_idx[far]] = False
+    restricted = ~inside
+    candidates = np.flatnonzero(undecided & inside)
+    touching = shapely.dwithin(
+        index.boundary, shapely.points(east_m[candidates], north_m[candidates]), inner_m
+    )
+    restricted[candidates[touching]] = True
+    exact = candidates[~touching]
+    if len(exact):
+        ellipses = ellipse_polygons(
+            north_m[exact], east_m[exact], heading_deg[exact], a_m, b_m, n_vertices
+        )
+        restricted[exact] = ~shapely.contains_properly(index.water, ellipses)
+    return restricted
+
+
+def _policy_holds(
+    policy: RestrictionPolicy, flags: NDArray[np.bool_], clockwise: NDArray[np.bool_]
+) -> bool:
+    starboard = bool(flags[clockwise].any())
+    port = bool(flags[~clockwise].any())
+    if policy is RestrictionPolicy.ANY:
+        return starboard or port
+    if policy is RestrictionPolicy.BOTH_SIDES:
+        return starboard and port
+    return starboard
+
+
+def verdict(
+    policy: RestrictionPolicy,
+    arc: NDArray[np.str_],
+    restricted: NDArray[np.bool_],
+    covered: NDArray[np.bool_],
+    start_covered: bool,
+) -> Restriction:
+    """Three-valued verdict: uncovered positions are neither red nor blue (module docstring)."""
+    if not start_covered:
+        return Restriction.UNKNOWN
+    clockwise = arc == Arc.CLOCKWISE.value
+    if _policy_holds(policy, restricted & covered, clockwise):
+        return Restriction.RESTRICTED
+    if _policy_holds(policy, restricted | ~covered, clockwise):
+        return Restriction.UNKNOWN
+    return Restriction.NOT_RESTRICTED
+
+
+@dataclass(frozen=True)
+class ManoeuvrabilityAssessment:
+    """One estimate: every projected position, its flag, and the verdict under ``policy``.
+
+    ``rate_of_swing_deg_per_m`` is the scaled δ' and ``turn_radius_m`` = 1/δ' (rad/m).
+    ``restricted`` is the geometric flag (ellipse not inside navigable water); ``covered``
+    tells whether the position is inside the chart. ``ellipses`` is built on first use.
+    """
+
+    restriction: Restriction
+    policy: RestrictionPolicy
+    rate_of_swing_deg_per_m: float
+    turn_radius_m: float
+    arc: NDArray[np.str_]
+    step: NDArray[np.int64]
+    north_m: NDArray[np.float64]
+    east_m: NDArray[np.float64]
+    heading_deg: NDArray[np.float64]
+    restricted: NDArray[np.bool_]
+    covered: NDArray[np.bool_]
+    length_m: float
+    breadth_m: float
+    draught_m: float
+    a_m: float
+    b_m: float
+
+    @functools.cached_property
+    def ellipses(self) -> NDArray[np.object_]:
+        return ellipse_polygons(self.north_m, self.east_m, self.heading_deg, self.a_m, self.b_m)
+
+
+def _check_target(**values: float) -> None:
+    for name, value in values.items():
+        if not math.isfinite(value):
+            raise ParameterError(f"target {name} {value} is not a finite number")
+    for name in ("length_m", "breadth_m"):
+        _positive(f"target {name}", values[name], "m")
+    for name in ("draught_m", "speed_mps"):
+        if values[name] < 0.0:
+            raise ParameterError(f"target {name} {values[name]} is negative; give a value >= 0")
+
+
+def assess_manoeuvrability(
+    chart: Chart | None,
+    north_m: float,
+    east_m: float,
+    course_deg: float,
+    speed_mps: float,
+    length_m: float,
+    breadth_m: float,
+    draught_m: float,
+    params: ManoeuvrabilityParams,
+) -> ManoeuvrabilityAssessment:
+    """Project both arcs, place the comfort zones and check them against the chart."""
+    _check_target(
+        north_m=north_m,
+        east_m=east_m,
+        course_deg=course_deg,
+        speed_mps=speed_mps,
+        length_m=length_m,
+        breadth_m=breadth_m,
+        draught_m=draught_m,
+    )
+    rate = params.alpha * target_rate_of_swing_deg_per_m(length_m, params)
+    arcs = turning_arcs(
+        north_m, east_m, course_deg, speed_mps, rate, params.horizon_s, params.step_s
+    )
+    a_m = params.domain_length_factor * length_m
+    b_m = params.domain_breadth_factor * breadth_m
+    if chart is None:
+        covered = np.zeros(len(arcs.arc), dtype=bool)
+        restricted = np.zeros(len(arcs.arc), dtype=bool)
+        restriction = Restriction.UNKNOWN
+    else:
+        covered_all = chart.covers(
+            np.append(arcs.north_m, north_m), np.append(arcs.east_m, east_m)
+        )
+        covered, start_covered = covered_all[:-1], bool(covered_all[-1])
+        restricted = restricted_flags(
+            chart.water_index(draught_m, params.ukc_m),
+            arcs.north_m,
+            arcs.east_m,
+            arcs.heading_deg,
+            a_m,
+            b_m,
+        )
+        restriction = verdict(params.policy, arcs.arc, restricted, covered, start_covered)
+    return ManoeuvrabilityAssessment(
+        restriction=restriction,
+        policy=params.policy,
+        rate_of_swing_deg_per_m=rate,
+        turn_radius_m=arcs.turn_radius_m,
+        arc=arcs.arc,
+        step=arcs.step,
+        north_m=arcs.north_m,
+        east_m=arcs.east_m,
+        heading_deg=arcs.heading_deg,
+        restricted=restricted,
+        covered=covered,
+        length_m=length_m,
+        breadth_m=breadth_m,
+        draught_m=draught_m,
+        a_m=a_m,
+        b_m=b_m,
+    )

@@ -1,0 +1,133 @@
+"""Drawing charts and manoeuvrability assessments on matplotlib axes, in local-frame metres.
+
+x is east (m), y is north (m), like the chart's geometry. The functions draw onto a given
+``Axes`` so that the chart command and the replay report share them. Each collection gets a
+``gid`` (``depth-areas``, ``land``, ``navigable-water``, ``restricted-ellipses``,
+``clear-ellipses``, ``unknown-ellipses``) so that tests and callers can find what was drawn.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import TYPE_CHECKING, Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+import shapely
+from matplotlib.axes import Axes
+from matplotlib.collections import PatchCollection
+from matplotlib.patches import PathPatch
+from matplotlib.path import Path as MplPath
+
+if TYPE_CHECKING:
+    from ..chart import Chart
+    from ..manoeuvrability import ManoeuvrabilityAssessment
+
+LAND_COLOUR = "#d9c7a0"
+WATER_EDGE_COLOUR = "#1a9850"
+RESTRICTED_COLOUR = "tab:red"
+CLEAR_COLOUR = "tab:blue"
+UNKNOWN_COLOUR = "0.5"
+DEPTH_CMAP = "Blues"
+
+
+def _ring_path(coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    codes = np.full(len(coords), MplPath.LINETO, dtype=np.uint8)
+    codes[0] = MplPath.MOVETO
+    codes[-1] = MplPath.CLOSEPOLY
+    return coords, codes
+
+
+def polygon_path(geometry: Any) -> MplPath | None:
+    """A matplotlib path (holes included) for a polygonal geometry; None when it has no area."""
+    vertices: list[np.ndarray] = []
+    codes: list[np.ndarray] = []
+    for part in shapely.get_parts(geometry):
+        if shapely.get_type_id(part) != shapely.GeometryType.POLYGON or part.is_empty:
+            continue
+        rings = [part.exterior, *part.interiors]
+        for ring in rings:
+            ring_vertices, ring_codes = _ring_path(np.asarray(ring.coords)[:, :2])
+            vertices.append(ring_vertices)
+            codes.append(ring_codes)
+    if not vertices:
+        return None
+    return MplPath(np.concatenate(vertices), np.concatenate(codes))
+
+
+def _patches(geometries: Iterable[Any]) -> tuple[list[PathPatch], list[int]]:
+    patches, kept = [], []
+    for i, geometry in enumerate(geometries):
+        path = polygon_path(geometry)
+        if path is not None:
+            patches.append(PathPatch(path))
+            kept.append(i)
+    return patches, kept
+
+
+def draw_chart(ax: Axes, chart: Chart, draught_m: float | None, ukc_m: float = 0.0) -> Any:
+    """Depth areas shaded by DRVAL1, land, and (with a draught) the navigable water outlined.
+
+    Returns the depth-area collection (a ScalarMappable, for a colour bar).
+    """
+    patches, kept = _patches(chart.depth_areas)
+    depths = PatchCollection(patches, cmap=DEPTH_CMAP, edgecolor="none", zorder=0)
+    depths.set_array(np.asarray(chart.drval1_m, dtype=float)[kept])
+    depths.set_gid("depth-areas")
+    ax.add_collection(depths)
+    land_patches, _ = _patches([chart.land])
+    land = PatchCollection(
+        land_patches, facecolor=LAND_COLOUR, edgecolor="0.4", linewidth=0.3, zorder=1
+    )
+    land.set_gid("land")
+    ax.add_collection(land)
+    if draught_m is not None:
+        water_patches, _ = _patches([chart.navigable_water(draught_m, ukc_m)])
+        water = PatchCollection(
+            water_patches,
+            facecolor=(0.1, 0.6, 0.3, 0.15),
+            edgecolor=WATER_EDGE_COLOUR,
+            linewidth=0.6,
+            zorder=2,
+        )
+        water.set_gid("navigable-water")
+        water.set_label(f"navigable for draught {draught_m:g} m + UKC {ukc_m:g} m")
+        ax.add_collection(water)
+    min_east, min_north, max_east, max_north = shapely.bounds(chart.coverage)
+    ax.update_datalim([(min_east, min_north), (max_east, max_north)])
+    ax.autoscale_view()
+    ax.set_aspect("equal", adjustable="datalim")
+    return depths
+
+
+def draw_assessment(ax: Axes, assessment: ManoeuvrabilityAssessment) -> None:
+    """Both arcs, and each comfort zone red (restricted), blue (clear) or grey (off the chart)."""
+    for arc, style in (("cw", "-"), ("ccw", "--")):
+        on_arc = assessment.arc == arc
+        ax.plot(
+            assessment.east_m[on_arc],
+            assessment.north_m[on_arc],
+            style,
+            color="black",
+            linewidth=0.8,
+            zorder=4,
+            label=f"{arc} arc",
+        )
+    groups = (
+        ("restricted-ellipses", assessment.restricted & assessment.covered, RESTRICTED_COLOUR),
+        ("clear-ellipses", ~assessment.restricted & assessment.covered, CLEAR_COLOUR),
+        ("unknown-ellipses", ~assessment.covered, UNKNOWN_COLOUR),
+    )
+    for gid, selected, colour in groups:
+        if not selected.any():
+            continue
+        patches, _ = _patches(assessment.ellipses[selected])
+        ellipses = PatchCollection(
+            patches, facecolor="none", edgecolor=colour, linewidth=0.5, zorder=3
+        )
+        ellipses.set_gid(gid)
+        ellipses.set_label(gid.replace("-", " "))
+        ax.add_collection(ellipses)

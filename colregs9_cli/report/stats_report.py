@@ -1,0 +1,223 @@
+"""The reports of ``colregs9 stats``: CSV, Markdown (the paper's table), histograms, run.json.
+
+Every file is written atomically. The statistics themselves come from ``colregs9_cli.stats``;
+this module only lays them out.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from datetime import UTC, datetime
+from enum import Enum
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
+
+from .. import __version__
+from .atomic import save_figure, write_csv, write_json, write_text
+
+if TYPE_CHECKING:
+    from ..ais.load import AisData
+    from ..query import Query
+    from ..stats import StatsResult, StatsTable
+
+CSV_NAME = "dimension_stats.csv"
+MARKDOWN_NAME = "dimension_stats.md"
+HISTOGRAM_NAME = "dimension_histograms.png"
+MANIFEST_NAME = "run.json"
+
+DIMENSION_LABELS: dict[str, str] = {
+    "length_m": "Length (m)",
+    "breadth_m": "Breadth (m)",
+    "draught_m": "Draught (m)",
+}
+HISTOGRAM_MAX_BINS = 40
+
+
+def _number(value: float, decimals: int) -> str:
+    return "" if math.isnan(value) else f"{value:.{decimals}f}"
+
+
+def _units(n: int, unit_name: str) -> str:
+    return f"{n} {unit_name.removesuffix('s') if n == 1 else unit_name}"
+
+
+def _title(result: StatsResult, query_name: str) -> str:
+    counted = result.vessels if result.per.value == "vessel" else result.messages
+    return (
+        f"Vessel dimensions, query '{query_name}', per {result.per.value} "
+        f"({_units(counted, result.unit_name)})"
+    )
+
+
+def _text_table(table: StatsTable) -> list[str]:
+    header = ["dimension", "count", "mean", "median", "std", "min", "max", "missing"]
+    lines = [header]
+    for row in table.rows:
+        lines.append(
+            [
+                row.dimension,
+                str(row.count),
+                *(_number(getattr(row, name), 2) for name in ("mean", "median", "std", "min")),
+                _number(row.max, 2),
+                str(row.missing),
+            ]
+        )
+    widths = [max(len(line[i]) for line in lines) for i in range(len(header))]
+    return [
+        "  ".join(
+            cell.ljust(width) if i == 0 else cell.rjust(width)
+            for i, (cell, width) in enumerate(zip(line, widths, strict=True))
+        ).rstrip()
+        for line in lines
+    ]
+
+
+def format_text(result: StatsResult, query_name: str) -> str:
+    """The plain, aligned table printed to stdout (NaN shown as an empty cell)."""
+    lines = [_title(result, query_name), *_text_table(result.overall)]
+    for table in result.groups:
+        lines += ["", f"ship type {table.group} ({_units(table.units, result.unit_name)})"]
+        lines += _text_table(table)
+    return "\n".join(lines) + "\n"
+
+
+def _markdown_table(table: StatsTable) -> list[str]:
+    lines = [
+        "| Dimension | mean | median | std | min | max | count | missing |",
+        "|:--|--:|--:|--:|--:|--:|--:|--:|",
+    ]
+    for row in table.rows:
+        cells = [
+            _number(getattr(row, name), 1) or "–"
+            for name in ("mean", "median", "std", "min", "max")
+        ]
+        lines.append(
+            f"| {DIMENSION_LABELS[row.dimension]} | {' | '.join(cells)} "
+            f"| {row.count} | {row.missing} |"
+        )
+    return lines
+
+
+def format_markdown(result: StatsResult, query_name: str) -> str:
+    """The paper's Table "Statistical overview of vessel dimensions", plus count and missing."""
+    unit = "vessel" if result.per.value == "vessel" else "position message"
+    lines = [
+        f"# Statistical overview of vessel dimensions: {query_name}",
+        "",
+        f"{_title(result, query_name)}. `count` is the number of {unit}s with a value, "
+        f"`missing` the number without one; std is the sample standard deviation "
+        "(ddof = 1), shown as – when fewer than two values exist.",
+        "",
+        *_markdown_table(result.overall),
+    ]
+    for table in result.groups:
+        units = _units(table.units, result.unit_name)
+        lines += ["", f"## Ship type: {table.group} ({units})", ""]
+        lines += _markdown_table(table)
+    return "\n".join(lines) + "\n"
+
+
+def histogram_figure(result: StatsResult, query_name: str) -> Figure:
+    """Three histograms (length, breadth, draught) of the counted units' values."""
+    figure, axes = plt.subplots(1, 3, figsize=(13, 4), layout="constrained")
+    for axis, (dimension, label) in zip(axes, DIMENSION_LABELS.items(), strict=True):
+        values = result.samples[dimension].dropna().to_numpy(dtype=float)
+        if values.size:
+            bins = min(HISTOGRAM_MAX_BINS, len(np.histogram_bin_edges(values, bins="auto")) - 1)
+            axis.hist(values, bins=max(bins, 1), color="tab:blue", edgecolor="white")
+        else:
+            axis.text(0.5, 0.5, "no values", ha="center", va="center", transform=axis.transAxes)
+        axis.yaxis.set_major_locator(MaxNLocator(integer=True))
+        axis.set_xlabel(label)
+        axis.set_ylabel(result.unit_name)
+        axis.set_title(f"{label}: n = {values.size}")
+    figure.suptitle(_title(result, query_name))
+    return figure
+
+
+def _jsonable(value: Any) -> Any:
+    """Query parts (dataclasses, enums, paths, datetimes, geometries) as JSON values."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: _jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, Enum):
+        return value.value
+    if isinstance(value, Mapping):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | set | frozenset):
+        items = [_jsonable(v) for v in value]
+        return sorted(items, key=str) if isinstance(value, set | frozenset) else items
+    if isinstance(value, datetime):
+        return value.isoformat()
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    if value is None or isinstance(value, str | int | float | bool):
+        return value
+    if hasattr(value, "wkt"):
+        return value.wkt
+    return str(value)
+
+
+def build_manifest(result: StatsResult, query: Query, data: AisData) -> dict[str, Any]:
+    """The content of run.json: what was read, what the query kept, and the result."""
+    return {
+        "tool": "colregs9",
+        "version": __version__,
+        "command": "stats",
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+        "query": {
+            "name": query.name,
+            "description": query.description,
+            "source": None if query.source is None else str(query.source),
+            "region": _jsonable(query.region),
+            "time": _jsonable(query.time),
+            "vessels": _jsonable(query.vessels),
+        },
+        "inputs": [
+            {
+                "path": str(item.path),
+                "sha256": item.sha256,
+                "layout": item.layout,
+                "rows_read": item.rows_read,
+            }
+            for item in data.inputs
+        ],
+        "rows_read": data.ledger.rows_read,
+        "rows_in_query": data.rows_in_query,
+        "ledger": data.ledger.to_dict(),
+        "per": result.per.value,
+        "by": None if result.by is None else result.by.value,
+        "vessels": result.vessels,
+        "messages": result.messages,
+        "table": result.overall.to_dict(),
+        "groups": [table.to_dict() for table in result.groups],
+    }
+
+
+def write_stats_reports(
+    out_dir: Path, result: StatsResult, query_name: str, manifest: dict[str, Any]
+) -> tuple[Path, ...]:
+    """Write the four report files into ``out_dir``; returns their paths."""
+    csv_path = out_dir / CSV_NAME
+    markdown_path = out_dir / MARKDOWN_NAME
+    histogram_path = out_dir / HISTOGRAM_NAME
+    manifest_path = out_dir / MANIFEST_NAME
+    write_csv(csv_path, result.to_frame())
+    write_text(markdown_path, format_markdown(result, query_name))
+    figure = histogram_figure(result, query_name)
+    try:
+        save_figure(histogram_path, figure, dpi=110)
+    finally:
+        plt.close(figure)
+    write_json(manifest_path, manifest)
+    return (csv_path, markdown_path, histogram_path, manifest_path)

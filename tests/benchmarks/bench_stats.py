@@ -1,0 +1,164 @@
+"""Benchmark: the region filter of ``colregs9 stats`` against polars and duckdb.
+
+Generates DMA 26-column CSVs (default 2.5 M and 5 M rows) in a temporary directory, then,
+on the same file in the same run, times each tool in its own subprocess:
+
+- ``colregs9 stats``: the whole command (read, filter, statistics, four report files);
+- ``colregs9 load_ais``: only the streaming read and query filter behind it;
+- ``polars``: ``scan_csv(...).filter(box).collect()``;
+- ``duckdb``: ``SELECT * FROM read_csv(...) WHERE box``.
+
+Wall time is measured by the parent around the subprocess (interpreter start and imports
+included, the same for all). Peak RSS is the child's own ``getrusage(RUSAGE_SELF).ru_maxrss``
+at exit, so each figure belongs to one tool. Every tool reports the rows and vessels it
+selected, so that the results can be seen to agree.
+
+Usage: python tests/benchmarks/bench_stats.py [--sizes 2500000 5000000] [--repeat 1]
+Needs the ``bench`` extra (polars, duckdb).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import tomllib
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[2]
+QUERY = ROOT / "queries" / "limfjorden.toml"
+TOOLS = ("colregs9 stats", "colregs9 load_ais", "polars", "duckdb")
+
+
+def _box() -> tuple[float, float, float, float]:
+    region = tomllib.loads(QUERY.read_text(encoding="utf-8"))["region"]
+    return region["lat_min"], region["lat_max"], region["lon_min"], region["lon_max"]
+
+
+def _run_tool(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
+    """Run one tool in this (child) process; returns what it selected."""
+    lat_min, lat_max, lon_min, lon_max = _box()
+    if tool == "colregs9 stats":
+        from colregs9_cli.stats import run_stats
+
+        run = run_stats([csv_path], query_path=QUERY, out_dir=out_dir, quiet=True)
+        return {"rows": run.manifest["rows_in_query"], "vessels": run.result.vessels}
+    if tool == "colregs9 load_ais":
+        from colregs9_cli.ais.load import load_ais
+        from colregs9_cli.query import load_query
+
+        data = load_ais([csv_path], query=load_query(QUERY), quiet=True)
+        return {"rows": len(data.positions), "vessels": int(data.positions["mmsi"].nunique())}
+    if tool == "polars":
+        import polars as pl
+
+        frame = (
+            pl.scan_csv(csv_path)
+            .filter(
+                pl.col("Latitude").is_between(lat_min, lat_max)
+                & pl.col("Longitude").is_between(lon_min, lon_max)
+            )
+            .collect()
+        )
+        return {"rows": frame.height, "vessels": frame["MMSI"].n_unique()}
+    if tool == "duckdb":
+        import duckdb
+
+        table = duckdb.sql(
+            f"SELECT * FROM read_csv('{csv_path}') "
+            f"WHERE Latitude BETWEEN {lat_min} AND {lat_max} "
+            f"AND Longitude BETWEEN {lon_min} AND {lon_max}"
+        ).to_arrow_table()
+        return {"rows": table.num_rows, "vessels": len(table.column("MMSI").unique())}
+    raise ValueError(tool)
+
+
+def _child(tool: str, csv_path: Path, out_dir: Path) -> None:
+    selected = _run_tool(tool, csv_path, out_dir)
+    peak_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss  # KiB on Linux
+    print(json.dumps({**selected, "peak_rss_mb": peak_kib / 1024}))
+
+
+def _measure(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
+    started = time.perf_counter()
+    completed = subprocess.run(
+        [sys.executable, __file__, "--child", tool, str(csv_path), str(out_dir)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    wall_s = time.perf_counter() - started
+    if completed.returncode != 0:
+        raise SystemExit(f"{tool} failed on {csv_path}:\n{completed.stderr}")
+    return {**json.loads(completed.stdout.strip().splitlines()[-1]), "wall_s": wall_s}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[2_500_000, 5_000_000])
+    parser.add_argument("--repeat", type=int, default=1, help="runs per tool; the median counts")
+    parser.add_argument("--keep", action="store_true", help="keep the generated files")
+    parser.add_argument("--child", nargs=3, metavar=("TOOL", "CSV", "OUT"), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        tool, csv_path, out_dir = args.child
+        _child(tool, Path(csv_path), Path(out_dir))
+        return
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from gen_dma_csv import generate
+
+    workdir = Path(tempfile.mkdtemp(prefix="colregs9-bench-"))
+    print(f"box {_box()} from {QUERY.relative_to(ROOT)}; files in {workdir}")
+    results: list[dict[str, Any]] = []
+    try:
+        for rows in args.sizes:
+            csv_path = generate(workdir / f"aisdk_{rows}.csv", rows=rows)
+            size_mb = csv_path.stat().st_size / 1e6
+            print(f"\n{rows:,} rows, {size_mb:,.0f} MB")
+            for tool in TOOLS:
+                runs = [_measure(tool, csv_path, workdir / "out") for _ in range(args.repeat)]
+                result = {
+                    "rows_in_file": rows,
+                    "file_mb": size_mb,
+                    "tool": tool,
+                    "wall_s": statistics.median(r["wall_s"] for r in runs),
+                    "peak_rss_mb": max(r["peak_rss_mb"] for r in runs),
+                    "rows": runs[0]["rows"],
+                    "vessels": runs[0]["vessels"],
+                }
+                results.append(result)
+                print(
+                    f"  {tool:18s} {result['wall_s']:7.2f} s  {result['peak_rss_mb']:7.0f} MB"
+                    f"  rows {result['rows']:,}  vessels {result['vessels']:,}"
+                )
+            csv_path.unlink()
+    finally:
+        if not args.keep:
+            shutil.rmtree(workdir, ignore_errors=True)
+
+    print(
+        "\n| rows in file | file size | tool | wall time | × fastest | peak RSS | rows selected "
+        "| vessels |"
+    )
+    print("|--:|--:|:--|--:|--:|--:|--:|--:|")
+    for rows in args.sizes:
+        at_size = [r for r in results if r["rows_in_file"] == rows]
+        fastest = min(r["wall_s"] for r in at_size)
+        for r in at_size:
+            print(
+                f"| {rows:,} | {r['file_mb']:,.0f} MB | {r['tool']} | {r['wall_s']:.1f} s "
+                f"| {r['wall_s'] / fastest:.2f} | {r['peak_rss_mb']:,.0f} MB | {r['rows']:,} "
+                f"| {r['vessels']:,} |"
+            )
+
+
+if __name__ == "__main__":
+    main()

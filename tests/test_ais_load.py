@@ -1,0 +1,117 @@
+"""The load pipeline: query filtering, no-data errors, and the ledger-balance property."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from colregs9_cli.ais.load import load_ais
+from colregs9_cli.errors import NoDataError
+from colregs9_cli.query import Query, Region, TimeWindow, VesselFilter, load_query
+
+ROOT = Path(__file__).resolve().parents[1]
+DMA26 = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
+HEADER = DMA26.read_text().splitlines()[0]
+
+
+def test_region_box_filters_and_counts_outside(tmp_path: Path) -> None:
+    # Rows with lat 57-58 and lon 9-10 (awk on the fixture): 219281000 (57.504843, 9.463187)
+    # and 219019010 (57.594313, 9.95935).
+    query = Query(name="box", region=Region(57.0, 58.0, 9.0, 10.0))
+    data = load_ais([DMA26], query=query)
+    assert sorted(data.positions["mmsi"]) == [219019010, 219281000]
+    ledger = data.ledger
+    # 15 distinct positions in all, 2 inside; the duplicate of 219281000 is inside too.
+    assert ledger.rows_outside_query == 13 and ledger.rejects["duplicate"] == 1
+    assert ledger.balanced
+
+
+def test_time_window_and_vessel_filter() -> None:
+    import datetime as dt
+
+    start = dt.datetime(2024, 9, 9, 0, 0, 36, tzinfo=dt.UTC)
+    query = Query(
+        name="late-cargo",
+        time=TimeWindow(start=start),
+        vessels=VesselFilter(ship_types=frozenset({"cargo"})),
+    )
+    data = load_ais([DMA26], query=query)
+    # Cargo at 00:00:36: HUMBRIA SEAWAYS (twice, one a duplicate) and AASLI; DIONE is at :33.
+    assert sorted(data.positions["mmsi"]) == [219281000, 257740000]
+    assert data.ledger.balanced
+
+
+def test_query_selecting_nothing_is_no_data_error() -> None:
+    query = load_query(ROOT / "queries" / "aalborg_fjord.toml")
+    with pytest.raises(NoDataError) as caught:
+        load_ais([DMA26], query=query)
+    message = str(caught.value)
+    assert "query 'aalborg_fjord'" in message and "selects no vessel positions" in message
+    assert "20 rows read" in message
+    assert caught.value.exit_code == 3
+
+
+def test_static_report_outside_query_still_counts_for_dimensions(tmp_path: Path) -> None:
+    lines = DMA26.read_text().splitlines()
+    static = next(line for line in lines if ",219000179," in line)
+    inside = static.replace(",91,0,", ",57.05,9.95,").replace("00:00:34", "00:01:00")
+    far = (
+        static.replace(",91,0,", ",55.0,12.0,")
+        .replace(",6,25,", ",6,30,")
+        .replace(",7,18,2,4", ",7,23,2,4")
+    )
+    path = tmp_path / "v.csv"
+    path.write_text("\n".join([HEADER, static, inside, far]) + "\n")
+    query = Query(name="fjord", region=Region(57.0, 57.1, 9.9, 10.0))
+    data = load_ais([path], query=query)
+    assert data.rows_in_query == 1 and data.ledger.rows_outside_query == 1
+    reports = data.dimension_reports.set_index("length_m")["n_reports"].to_dict()
+    assert reports == {25.0: 2, 30.0: 1}
+
+
+# -- the ledger always balances ----------------------------------------------------------------
+
+MOBILE = st.sampled_from(["Class A", "Class B", "Base Station", "AtoN", "SAR Airborne"])
+MMSI = st.sampled_from(["219000179", "257739000", "992111851", "2190045", "abc", ""])
+LAT = st.sampled_from(["57.05", "91", "", "north", "-90", "57.0500"])
+LON = st.sampled_from(["9.95", "181", "0", "", "12.5"])
+TIME = st.sampled_from(["09/09/2024 00:00:34", "09/09/2024 00:00:35", "31/02/2024 00:00:00", "x"])
+DIMS = st.sampled_from(["7,18,2,4", ",,,", "0,0,0,0", "7,,2,"])
+EXTRA = st.sampled_from(["", ",extra", ",a,b"])
+
+
+@st.composite
+def dma_row(draw: st.DrawFn) -> str:
+    return (
+        f"{draw(TIME)},{draw(MOBILE)},{draw(MMSI)},{draw(LAT)},{draw(LON)},Unknown value,0,1.5,"
+        f"90,91,Unknown,OVLI,NAME,{draw(st.sampled_from(['Cargo', 'Undefined']))},,6,25,GPS,"
+        f"{draw(st.sampled_from(['2.5', '', '0']))},Unknown,,AIS,{draw(DIMS)}{draw(EXTRA)}"
+    )
+
+
+@settings(
+    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(rows=st.lists(dma_row(), min_size=1, max_size=30), boxed=st.booleans())
+def test_ledger_balances_on_generated_dma(tmp_path: Path, rows: list[str], boxed: bool) -> None:
+    # One valid row inside the box guarantees data, so every draw checks the balance.
+    anchor = (
+        "09/09/2024 00:00:40,Class A,219000179,57.05,9.95,Moored,0,0,90,91,Unknown,OVLI,NAME,"
+        "Cargo,,6,25,GPS,2.5,Unknown,,AIS,7,18,2,4"
+    )
+    rows = [*rows, anchor]
+    path = tmp_path / "gen.csv"
+    path.write_text("\n".join([HEADER, *rows]) + "\n")
+    query = Query(name="q", region=Region(57.0, 57.1, 9.9, 10.0)) if boxed else None
+    data = load_ais([path], query=query)
+    ledger = data.ledger
+    assert ledger.rows_read == len(rows)
+    assert ledger.rows_read == ledger.rows_used + ledger.rows_outside_query + ledger.rejected_total
+    assert data.rows_in_query == len(data.positions) <= ledger.rows_used
+    assert not data.positions.duplicated().any()
+    assert data.positions["mmsi"].between(201_000_000, 775_999_999).all()
+    assert pd.Series(data.positions["mobile_type"]).isin(["Class A", "Class B"]).all()

@@ -1,0 +1,95 @@
+"""`colregs9 chart` and the estimator's bad-input paths through the CLI."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from colregs9_cli.cli import app
+
+FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
+ENC = FIXTURES / "charts" / "noaa_enc_US5MD1MC.000"
+
+
+def _run(*args: str) -> object:
+    return CliRunner().invoke(app, list(args))
+
+
+def test_chart_summary() -> None:
+    result = _run("chart", str(ENC))
+    assert result.exit_code == 0, result.output
+    assert "DEPARE     239" in result.output
+    assert "DRVAL1 -0.5 .. 9.1 m" in result.output
+    assert "lat 38.92500 .. 39.00000, lon -76.50000 .. -76.42500" in result.output
+    assert "Navigable" not in result.output
+
+
+def test_chart_with_a_draught_prints_the_area_and_draws(tmp_path: Path) -> None:
+    out = tmp_path / "enc.png"
+    args = ["--draught", "4.5", "--ukc", "0.5", "--out", str(out), "--quiet"]
+    result = _run("chart", str(ENC), *args)
+    assert result.exit_code == 0, result.output
+    line = next(x for x in result.output.splitlines() if x.startswith("Navigable water"))
+    assert "draught 4.5 m + UKC 0.5 m" in line
+    # 4.5 m + 0.5 m needs DRVAL1 >= 5 m: the 5 m navigable area of test_chart.
+    assert line.endswith(": 10.070 km²")
+    assert out.stat().st_size > 10_000
+
+
+def _one_error_line(result: object, *fragments: str) -> None:
+    assert result.exit_code != 0
+    assert result.exception is None or isinstance(result.exception, SystemExit)
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error: "), result.output
+    assert "Traceback" not in result.output
+    for fragment in fragments:
+        assert fragment in lines[0]
+
+
+def test_not_a_chart(tmp_path: Path) -> None:
+    text = tmp_path / "readme.000"
+    text.write_text("hello\n")
+    _one_error_line(_run("chart", str(text)), "readme.000")
+    noise = tmp_path / "random.geojson"
+    noise.write_text('{"type": "FeatureCollection", "features": [{"type": "Feature", '
+                     '"properties": {"a": 1}, "geometry": {"type": "Point", '
+                     '"coordinates": [1, 2]}}]}')
+    _one_error_line(_run("chart", str(noise)), "random.geojson", "OBJL")
+    garbage = tmp_path / "garbage.geojson"
+    garbage.write_bytes(b"\x00\x01 not json")
+    _one_error_line(_run("chart", str(garbage)), "garbage.geojson")
+
+
+def _geojson(path: Path, **properties: object) -> Path:
+    feature = {
+        "type": "Feature",
+        "properties": properties,
+        "geometry": {"type": "Polygon", "coordinates": [[[9.9, 57.0], [9.95, 57.0],
+                                                         [9.95, 57.05], [9.9, 57.0]]]},
+    }
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    return path
+
+
+def test_a_chart_with_no_depth_areas(tmp_path: Path) -> None:
+    path = _geojson(tmp_path / "land.geojson", OBJL="LNDARE", DRVAL1=None)
+    _one_error_line(_run("chart", str(path)), "land.geojson", "no depth areas")
+
+
+def test_a_geojson_without_drval1(tmp_path: Path) -> None:
+    path = _geojson(tmp_path / "nodepth.geojson", OBJL="DEPARE", DEPTH=4.0)
+    _one_error_line(_run("chart", str(path)), "nodepth.geojson", "DRVAL1")
+
+
+@pytest.mark.parametrize(("option", "value"), [("--draught", "-5"), ("--ukc", "-1")])
+def test_negative_draught_or_ukc(option: str, value: str) -> None:
+    _one_error_line(_run("chart", str(ENC), option, value), option, value)
+
+
+def test_alpha_outside_zero_one(tmp_path: Path) -> None:
+    ais = FIXTURES / "ais" / "aisdk_2024-09-09_sample.csv"
+    result = _run("replay", str(ais), "--alpha", "1.5", "--no-plots", "--out", str(tmp_path))
+    _one_error_line(result, "alpha 1.5 is outside [0, 1]")
