@@ -271,7 +271,7 @@ def chart_command(
     ] = 0.0,
     out: Annotated[
         Path | None,
-        typer.Option("--out", help="Plot file (with --draught). Default: reports/chart-<stem>.png."),
+        typer.Option("--out", help="Plot file (with --draught); reports/chart-<stem>.png."),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:

@@ -399,6 +399,7 @@ def evaluate_encounter(
     )
     restricted_statuses = params.replay.restricted_nav_statuses
     verdicts: list[Rule9Assessment] = []
+    runs: dict[tuple[Role, int | None, Restriction], Rule9Assessment] = {}
     estimates: list[Restriction] = []
     assessed_at: list[pd.Timestamp] = []
     trigger_assessment: ManoeuvrabilityAssessment | None = None
@@ -413,9 +414,11 @@ def evaluate_encounter(
         assessment = estimator.at(target_state, row, needed=reaches_d3)
         if row == 0:
             trigger_assessment = assessment
-        verdicts.append(
-            assess_rule9(own_role, nav_status, assessment.restriction, restricted_statuses)
-        )
+        # G_d depends on these three observations only; most steps repeat the last ones.
+        key = (own_role, nav_status, assessment.restriction)
+        if key not in runs:
+            runs[key] = assess_rule9(*key, restricted_statuses)
+        verdicts.append(runs[key])
         estimates.append(assessment.restriction)
         assessed_at.append(timestamps[estimator.assessed_row])
     assert trigger_assessment is not None  # the trigger step is always in the series

@@ -54,9 +54,11 @@ def test_not_a_chart(tmp_path: Path) -> None:
     text.write_text("hello\n")
     _one_error_line(_run("chart", str(text)), "readme.000")
     noise = tmp_path / "random.geojson"
-    noise.write_text('{"type": "FeatureCollection", "features": [{"type": "Feature", '
-                     '"properties": {"a": 1}, "geometry": {"type": "Point", '
-                     '"coordinates": [1, 2]}}]}')
+    noise.write_text(
+        '{"type": "FeatureCollection", "features": [{"type": "Feature", '
+        '"properties": {"a": 1}, "geometry": {"type": "Point", '
+        '"coordinates": [1, 2]}}]}'
+    )
     _one_error_line(_run("chart", str(noise)), "random.geojson", "OBJL")
     garbage = tmp_path / "garbage.geojson"
     garbage.write_bytes(b"\x00\x01 not json")
@@ -67,8 +69,10 @@ def _geojson(path: Path, **properties: object) -> Path:
     feature = {
         "type": "Feature",
         "properties": properties,
-        "geometry": {"type": "Polygon", "coordinates": [[[9.9, 57.0], [9.95, 57.0],
-                                                         [9.95, 57.05], [9.9, 57.0]]]},
+        "geometry": {
+            "type": "Polygon",
+            "coordinates": [[[9.9, 57.0], [9.95, 57.0], [9.95, 57.05], [9.9, 57.0]]],
+        },
     }
     path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
     return path

@@ -211,13 +211,17 @@ def test_restriction_flags_are_translation_invariant(
     chart = _square_chart(120.0)
     moved = Chart(
         frame=chart.frame,
-        depth_areas=shapely.transform(chart.depth_areas, lambda xy: xy + [shift_east, shift_north]),
+        depth_areas=shapely.transform(
+            chart.depth_areas, lambda xy: xy + np.array([shift_east, shift_north])
+        ),
         drval1_m=chart.drval1_m,
         drval2_m=chart.drval2_m,
         kinds=chart.kinds,
         land=chart.land,
         hazards=chart.hazards,
-        coverage=shapely.transform(chart.coverage, lambda xy: xy + [shift_east, shift_north]),
+        coverage=shapely.transform(
+            chart.coverage, lambda xy: xy + np.array([shift_east, shift_north])
+        ),
     )
     params = ManoeuvrabilityParams(horizon_s=60.0)
     here = assess_manoeuvrability(chart, north, east, course, 3.0, 50.0, 9.0, 5.0, params)
@@ -250,7 +254,11 @@ def test_policies(flags: list[int], expected: tuple[str, str, str]) -> None:
     covered = np.ones(6, dtype=bool)
     got = tuple(
         verdict(policy, ARC, restricted, covered, True).value
-        for policy in (RestrictionPolicy.ANY, RestrictionPolicy.BOTH_SIDES, RestrictionPolicy.STARBOARD)
+        for policy in (
+            RestrictionPolicy.ANY,
+            RestrictionPolicy.BOTH_SIDES,
+            RestrictionPolicy.STARBOARD,
+        )
     )
     assert got == expected
 
@@ -264,7 +272,8 @@ def test_uncovered_positions_are_never_clear() -> None:
     assert verdict(RestrictionPolicy.ANY, ARC, red, off_chart, True) is Restriction.RESTRICTED
     # Starboard only looks at the clockwise arc, which is fully charted and clear.
     port_off = np.array([1, 1, 1, 0, 0, 0], dtype=bool)
-    assert verdict(RestrictionPolicy.STARBOARD, ARC, clear, port_off, True) is Restriction.NOT_RESTRICTED
+    starboard = verdict(RestrictionPolicy.STARBOARD, ARC, clear, port_off, True)
+    assert starboard is Restriction.NOT_RESTRICTED
     covered = np.ones(6, dtype=bool)
     assert verdict(RestrictionPolicy.ANY, ARC, clear, covered, False) is Restriction.UNKNOWN
 
@@ -412,7 +421,7 @@ def test_outside_the_chart_is_unknown(enc: Chart) -> None:
 
 
 def test_the_fast_classifier_equals_a_per_ellipse_check(enc: Chart) -> None:
-    """The distance pre-filters in restricted_flags are exact: compare with brute force."""
+    """The distance pre-filter in restricted_flags is exact: compare with brute force."""
     index = enc.water_index(5.0)
     rng = np.random.default_rng(7)
     north, east = _widest_deep_water(enc)

@@ -338,6 +338,7 @@ BOX = "[region]\nlat_min = 56.5\nlat_max = 57.2\nlon_min = 8.2\nlon_max = 10.4\n
         ("empty file", 2, "empty.csv"),
         ("unknown layout", 2, "layout.csv"),
         ("unknown --format", 2, "bogus"),
+        ("unknown --per", 2, "bogus"),
         ("truncated gzip", 2, "truncated.txt.gz"),
         ("non-UTF-8 byte", 2, "latin1.csv"),
         ("TOML syntax error", 2, "q.toml"),
@@ -361,6 +362,8 @@ def test_bad_input_gives_one_error_line(
         ais.write_text("when,where,who\n1,2,3\n")
     elif case == "unknown --format":
         args = ["--format", "bogus"]
+    elif case == "unknown --per":
+        args = ["--per", "bogus"]
     elif case == "truncated gzip":
         ais = tmp_path / "truncated.txt.gz"
         data = NMEA.read_bytes()

@@ -45,9 +45,7 @@ def test_figure_plots_each_class_at_its_lengths_and_rates() -> None:
         for vessel_type, rows in table.groupby("vessel_type"):
             expected = rows[["length_m", "rate_of_swing_deg_per_m"]].to_numpy()
             np.testing.assert_allclose(np.asarray(scatters[vessel_type]), expected)
-        markers = {
-            c.get_label(): c.get_paths()[0].vertices.shape[0] for c in ax.collections
-        }
+        markers = {c.get_label(): c.get_paths()[0].vertices.shape[0] for c in ax.collections}
         assert markers["tanker"] != markers["coastguard"]  # square vs triangle, as in the paper
         levels = sorted(line.get_ydata()[0] for line in ax.get_lines())
         assert levels == [table["rate_of_swing_deg_per_m"].min(), 0.2]

@@ -1,0 +1,126 @@
+"""Benchmark: manoeuvrability assessments per second on the real ENC at 5 m draught.
+
+One assessment = both arcs over the paper's 180 s horizon at 1 s (360 projected positions and
+comfort zones) for a 50 m × 9 m, 5 m-draught target at 7 kn, the paper's defaults. Compared in
+the same run with the same work done as a plain per-ellipse shapely loop:
+
+- ``loop, prepared``: one ``shapely.Polygon`` per position and ``water.contains_properly``
+  against the same prepared navigable water;
+- ``loop, unprepared``: the same against an unprepared copy of the water (the naive code).
+
+The prepared navigable water is built once per (draught, UKC) and cached on the chart
+(``Chart.water_index``); its one-off build time is reported separately and is not part of an
+assessment. Run: ``python tests/benchmarks/bench_manoeuvrability.py [--seconds S]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import shapely
+from shapely.ops import polylabel
+
+from colregs9_cli.chart import Chart, load_chart
+from colregs9_cli.manoeuvrability import (
+    ManoeuvrabilityParams,
+    assess_manoeuvrability,
+    target_rate_of_swing_deg_per_m,
+    turning_arcs,
+)
+
+ENC = Path(__file__).resolve().parents[2] / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
+DRAUGHT_M, LENGTH_M, BREADTH_M = 5.0, 50.0, 9.0
+SPEED_MPS = 7.0 * 1852.0 / 3600.0
+
+
+def _rate(run: Callable[[], object], seconds: float) -> float:
+    """Calls per second over at least ``seconds`` (after one warm-up call)."""
+    run()
+    calls, start = 0, time.perf_counter()
+    while (elapsed := time.perf_counter() - start) < seconds:
+        run()
+        calls += 1
+    return calls / elapsed
+
+
+def _loop_assessment(water: object, north: float, east: float, course: float) -> np.ndarray:
+    params = ManoeuvrabilityParams()
+    rate = params.alpha * target_rate_of_swing_deg_per_m(LENGTH_M, params)
+    arcs = turning_arcs(north, east, course, SPEED_MPS, rate, params.horizon_s, params.step_s)
+    a_m, b_m = params.domain_length_factor * LENGTH_M, params.domain_breadth_factor * BREADTH_M
+    t_rad = np.linspace(0.0, 2.0 * np.pi, 33)
+    flags = []
+    for n, e, h in zip(arcs.north_m, arcs.east_m, arcs.heading_deg, strict=True):
+        h_rad = math.radians(h)
+        fwd, stbd = a_m * np.cos(t_rad), b_m * np.sin(t_rad)
+        ring = np.column_stack(
+            [
+                e + fwd * math.sin(h_rad) + stbd * math.cos(h_rad),
+                n + fwd * math.cos(h_rad) - stbd * math.sin(h_rad),
+            ]
+        )
+        flags.append(not water.contains_properly(shapely.Polygon(ring)))
+    return np.array(flags)
+
+
+def _positions(chart: Chart) -> dict[str, tuple[float, float, float]]:
+    water = chart.navigable_water(DRAUGHT_M)
+    parts = shapely.get_parts(water)
+    open_water = polylabel(parts[np.argmax(shapely.area(parts))], tolerance=1.0)
+    # The Severn River reach used in tests/test_manoeuvrability.py, heading down the channel.
+    reach = shapely.get_parts(shapely.intersection(water, shapely.box(-4e3, 2.6e3, 4e3, 3.4e3)))
+    channel = reach[np.argmax(shapely.area(reach))].centroid
+    return {
+        "Severn channel (restricted)": (channel.y, channel.x, 145.0),
+        "widest deep water (clear)": (open_water.y, open_water.x, 45.0),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=3.0, help="time per measurement")
+    args = parser.parse_args()
+
+    chart = load_chart([ENC])
+    start = time.perf_counter()
+    index = chart.water_index(DRAUGHT_M)
+    build_s = time.perf_counter() - start
+    unprepared = shapely.from_wkb(shapely.to_wkb(index.water))
+    params = ManoeuvrabilityParams()
+    print(f"navigable water for {DRAUGHT_M} m built once in {build_s * 1e3:.0f} ms, then cached")
+    print(f"{'position':<30} {'method':<20} {'assessments/s':>14} {'speed-up':>9}")
+    for name, (north, east, course) in _positions(chart).items():
+        fast = assess_manoeuvrability(
+            chart, north, east, course, SPEED_MPS, LENGTH_M, BREADTH_M, DRAUGHT_M, params
+        )
+        for water in (index.water, unprepared):
+            assert (_loop_assessment(water, north, east, course) == fast.restricted).all()
+        vectorised = _rate(
+            lambda n=north, e=east, c=course: assess_manoeuvrability(
+                chart, n, e, c, SPEED_MPS, LENGTH_M, BREADTH_M, DRAUGHT_M, params
+            ),
+            args.seconds,
+        )
+        rows = [("vectorised", vectorised)]
+        for label, water in (("loop, prepared", index.water), ("loop, unprepared", unprepared)):
+            rows.append(
+                (
+                    label,
+                    _rate(
+                        lambda w=water, n=north, e=east, c=course: _loop_assessment(w, n, e, c),
+                        args.seconds,
+                    ),
+                )
+            )
+        for label, rate in rows:
+            print(f"{name:<30} {label:<20} {rate:>14.0f} {vectorised / rate:>8.1f}×")
+        print(f"{'':<30} verdict {fast.restriction.value}, {fast.restricted.sum()} of 360 red")
+
+
+if __name__ == "__main__":
+    main()
