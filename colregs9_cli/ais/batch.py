@@ -39,7 +39,9 @@ class AisBatch:
 
     def __post_init__(self) -> None:
         if not self.positions.schema.equals(CANONICAL_SCHEMA):
-            raise TypeError(f"positions do not follow the canonical schema:\n{self.positions.schema}")
+            raise TypeError(
+                f"positions do not follow the canonical schema:\n{self.positions.schema}"
+            )
         if not self.statics.schema.equals(STATIC_SCHEMA):
             raise TypeError(f"statics do not follow the static schema:\n{self.statics.schema}")
 
