@@ -2,6 +2,11 @@
 
 Positions in the frame are ``north_m, east_m`` (the paper's NED frame, down omitted).
 The frame is chosen once per run and carried with the data; nothing falls back to a default.
+
+Grid north (the frame's ``north_m`` axis) differs from true north by the meridian convergence
+γ, about Δlon·sin(lat) from the central meridian (≈ 2° at the edges of Denmark for a frame
+centred on the country). Directions compared with frame positions or turned into frame
+velocities must be grid directions: ``grid = true − γ``.
 """
 
 from __future__ import annotations
@@ -10,9 +15,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from pyproj import CRS, Transformer
+from pyproj import CRS, Proj, Transformer
 
 from .errors import ParameterError
+from .units import wrap_deg
 
 
 @dataclass(frozen=True)
@@ -24,6 +30,7 @@ class LocalFrame:
     crs: CRS = field(init=False, repr=False, compare=False)
     _forward: Transformer = field(init=False, repr=False, compare=False)
     _inverse: Transformer = field(init=False, repr=False, compare=False)
+    _proj: Proj = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not (-90.0 < self.lat0_deg < 90.0 and -180.0 <= self.lon0_deg <= 180.0):
@@ -38,6 +45,7 @@ class LocalFrame:
         object.__setattr__(self, "crs", crs)
         object.__setattr__(self, "_forward", Transformer.from_crs("EPSG:4326", crs, always_xy=True))
         object.__setattr__(self, "_inverse", Transformer.from_crs(crs, "EPSG:4326", always_xy=True))
+        object.__setattr__(self, "_proj", Proj(crs))
 
     @classmethod
     def centred_on(
@@ -62,3 +70,34 @@ class LocalFrame:
             np.asarray(east_m, dtype=float), np.asarray(north_m, dtype=float)
         )
         return np.asarray(lat_deg, dtype=float), np.asarray(lon_deg, dtype=float)
+
+    def grid_convergence_deg(self, lat_deg: ArrayLike, lon_deg: ArrayLike) -> NDArray[np.float64]:
+        """Meridian convergence γ (degrees) at WGS84 positions: ``grid bearing = true − γ``.
+
+        γ is 0 on the central meridian and, in the northern hemisphere, positive east of it
+        (grid north lies east of true north there). NaN positions give NaN.
+        """
+        lat, lon = np.broadcast_arrays(
+            np.asarray(lat_deg, dtype=float), np.asarray(lon_deg, dtype=float)
+        )
+        gamma = np.full(lat.shape, np.nan)
+        known = np.isfinite(lat) & np.isfinite(lon)
+        if known.any():
+            # PROJ reports an unknown position as inf, not NaN: only known ones go in.
+            factors = self._proj.get_factors(lon[known], lat[known])
+            gamma[known] = np.asarray(factors.meridian_convergence, dtype=float)
+        return gamma
+
+    def true_to_grid_deg(
+        self, bearing_deg: ArrayLike, lat_deg: ArrayLike, lon_deg: ArrayLike
+    ) -> NDArray[np.float64]:
+        """True bearings at the given positions as grid bearings of the frame, in [0, 360)."""
+        gamma = self.grid_convergence_deg(lat_deg, lon_deg)
+        return wrap_deg(np.asarray(bearing_deg, dtype=float) - gamma)
+
+    def grid_to_true_deg(
+        self, bearing_deg: ArrayLike, lat_deg: ArrayLike, lon_deg: ArrayLike
+    ) -> NDArray[np.float64]:
+        """Grid bearings of the frame at the given positions as true bearings, in [0, 360)."""
+        gamma = self.grid_convergence_deg(lat_deg, lon_deg)
+        return wrap_deg(np.asarray(bearing_deg, dtype=float) + gamma)

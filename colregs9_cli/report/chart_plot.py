@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from ..manoeuvrability import ManoeuvrabilityAssessment
 
 LAND_COLOUR = "#d9c7a0"
-WATER_EDGE_COLOUR = "#1a9850"
+WATER_EDGE_COLOUR = "#00c853"
 RESTRICTED_COLOUR = "tab:red"
 CLEAR_COLOUR = "tab:blue"
 UNKNOWN_COLOUR = "0.5"
@@ -88,9 +88,9 @@ def draw_chart(ax: Axes, chart: Chart, draught_m: float | None, ukc_m: float = 0
         water_patches, _ = _patches([chart.navigable_water(draught_m, ukc_m)])
         water = PatchCollection(
             water_patches,
-            facecolor=(0.1, 0.6, 0.3, 0.15),
+            facecolor=(0.2, 0.85, 0.35, 0.25),
             edgecolor=WATER_EDGE_COLOUR,
-            linewidth=0.6,
+            linewidth=1.6,
             zorder=2,
         )
         water.set_gid("navigable-water")

@@ -1,0 +1,212 @@
+"""``colregs9 demo``: the paper's Greenhopper case study end to end.
+
+For each of the two scenarios (``greenhopper_restricted``, ``greenhopper_not_restricted``)
+it simulates the scenario's AIS, replays it on the modelled Aalborg chart with the paper's
+parameters (``queries/greenhopper.toml``) with the scenario's own ship (the Greenhopper) in
+the own-ship seat, and reports the verdict of her triggered encounter. Every file lands in
+one output directory:
+
+- ``simulate-<scenario>.csv``: the synthetic AIS;
+- ``<scenario>/``: the replay's reports (encounters.csv, encounters/<id>.csv and .png,
+  index.md, run.json);
+- ``<scenario>.png``: a copy of the encounter's figure, the paper's Figure "restricted" or
+  "not restricted".
+
+The inputs live in the repository, not in the installed package, so the default paths are
+relative to the current directory (the README runs the demo from the repository root).
+"""
+
+from __future__ import annotations
+
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+
+from .errors import InputFileError, NoDataError
+from .replay import EncounterOutcome, ReplayResult, run_replay
+from .report.replay_report import ENCOUNTER_DIR
+from .simulate import SimulationResult, simulate_scenario
+
+SCENARIO_NAMES: tuple[str, ...] = ("greenhopper_restricted", "greenhopper_not_restricted")
+DEFAULT_OUT_DIR = Path("reports") / "demo"
+DEFAULT_SCENARIOS_DIR = Path("fixtures") / "scenarios"
+DEFAULT_CHART = Path("fixtures") / "charts" / "aalborg_modelled.geojson"
+DEFAULT_QUERY = Path("queries") / "greenhopper.toml"
+
+
+@dataclass(frozen=True)
+class PaperVerdict:
+    """The outcome the paper reports for a scenario (section "Simulation results")."""
+
+    target_estimated_restricted: str
+    rule9_applied: bool
+    own_role_final: str
+    automaton_path: str
+
+
+PAPER_VERDICTS: dict[str, PaperVerdict] = {
+    "greenhopper_restricted": PaperVerdict("true", True, "give-way", "D1>D2>D3>D4"),
+    "greenhopper_not_restricted": PaperVerdict("false", False, "stand-on", "D1>D2>D3>D1"),
+}
+
+
+@dataclass(frozen=True)
+class ScenarioVerdict:
+    """One scenario of the demo: its files and the verdict of the own ship's encounter."""
+
+    scenario: str
+    simulation: SimulationResult
+    replay: ReplayResult
+    outcome: EncounterOutcome
+    figure: Path
+
+    @property
+    def as_in_paper(self) -> bool:
+        expected = PAPER_VERDICTS.get(self.scenario)
+        s = self.outcome.summary
+        return expected is not None and expected == PaperVerdict(
+            s.target_estimated_restricted.value,
+            s.rule9_applied,
+            s.own_role_final.value,
+            s.automaton_path,
+        )
+
+
+@dataclass(frozen=True)
+class DemoResult:
+    out_dir: Path
+    verdicts: tuple[ScenarioVerdict, ...]
+
+    @property
+    def text(self) -> str:
+        return format_demo(self)
+
+
+def _yes_no(value: bool) -> str:
+    return "yes" if value else "no"
+
+
+def format_demo(result: DemoResult) -> str:
+    """The verdict table (one column per scenario) and where the files are."""
+    first = result.verdicts[0].outcome.summary
+    rows: list[tuple[str, list[str]]] = [("", [v.scenario for v in result.verdicts])]
+    fields: list[tuple[str, object]] = [
+        ("trigger (UTC)", lambda s: s.trigger_utc.strftime("%Y-%m-%d %H:%M:%S")),
+        ("situation", lambda s: s.situation.value),
+        ("own role under COLREGs", lambda s: s.own_role_colregs.value),
+        ("target reports restricted", lambda s: _yes_no(s.target_reports_restricted)),
+        ("target estimated restricted", lambda s: s.target_estimated_restricted.value),
+        ("rule 9 applied", lambda s: _yes_no(s.rule9_applied)),
+        ("own role after rule 9", lambda s: s.own_role_final.value),
+        ("automaton path", lambda s: s.automaton_path),
+        ("range at trigger", lambda s: f"{s.range_m_at_trigger:.0f} m"),
+        ("CPA at trigger", lambda s: f"{s.cpa_m:.0f} m"),
+        ("TCPA at trigger", lambda s: f"{s.tcpa_s:.0f} s"),
+    ]
+    for label, cell in fields:
+        rows.append((label, [cell(v.outcome.summary) for v in result.verdicts]))  # type: ignore[operator]
+    rows.append(("as in the paper", [_yes_no(v.as_in_paper) for v in result.verdicts]))
+    label_width = max(len(label) for label, _ in rows)
+    widths = [max(len(cells[i]) for _, cells in rows) for i in range(len(result.verdicts))]
+    lines = [
+        "Greenhopper case study (the paper's section \"Simulation results\"), modelled chart.",
+        f"Own ship {first.own_name} (MMSI {first.own_mmsi}); target {first.target_name} "
+        f"(MMSI {first.target_mmsi}).",
+        "",
+    ]
+    for label, cells in rows:
+        line = label.ljust(label_width) + "  " + "  ".join(
+            c.ljust(w) for c, w in zip(cells, widths, strict=True)
+        )
+        lines.append(line.rstrip())
+    lines.append("")
+    lines.append(f"Files in {result.out_dir}:")
+    for verdict in result.verdicts:
+        lines.append(
+            f"  {verdict.scenario}: AIS {verdict.simulation.out_path}, reports "
+            f"{verdict.replay.out_dir}/, figure {verdict.figure}"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _require(path: Path, option: str, kind: str) -> None:
+    exists = path.is_dir() if kind == "directory" else path.is_file()
+    if not exists:
+        raise InputFileError(
+            f"{path}: no such {kind} ({option}); run from the repository root or pass "
+            "--scenarios/--chart/--query"
+        )
+
+
+def _own_outcome(replay: ReplayResult, own_mmsi: int, scenario: str) -> EncounterOutcome:
+    """The own ship's first triggered encounter; none is an error: the demo shows nothing."""
+    outcomes = [o for o in replay.encounters if o.summary.own_mmsi == own_mmsi]
+    if not outcomes:
+        raise NoDataError(
+            f"scenario {scenario}: the replay found no triggered encounter for own ship MMSI "
+            f"{own_mmsi} (CPA < {replay.params.replay.cpa_req_m:g} m within 0 <= TCPA <= "
+            f"{replay.params.replay.tcpa_act_s:g} s); check the scenario and the query"
+        )
+    return min(outcomes, key=lambda o: o.summary.trigger_utc)
+
+
+def run_scenario(
+    scenario_path: Path,
+    out_dir: Path,
+    chart: Path,
+    query: Path,
+    quiet: bool = True,
+    overrides: dict[str, dict[str, object]] | None = None,
+) -> ScenarioVerdict:
+    """Simulate one scenario into ``out_dir`` and replay it with its own ship in the own seat."""
+    simulation = simulate_scenario(
+        scenario_path, out_dir / f"simulate-{scenario_path.stem}.csv", quiet=quiet
+    )
+    own = simulation.scenario.own
+    if own is None:
+        raise InputFileError(
+            f"{scenario_path}: no vessel has role = 'own'; the demo needs the Greenhopper's seat"
+        )
+    name = simulation.scenario.name
+    replay = run_replay(
+        [simulation.out_path],
+        chart_paths=[chart],
+        query_path=query,
+        own_mmsi=[own.mmsi],
+        out_dir=out_dir / name,
+        plots=True,
+        overrides=overrides,
+        quiet=quiet,
+    )
+    outcome = _own_outcome(replay, own.mmsi, name)
+    figure = out_dir / f"{name}.png"
+    shutil.copyfile(
+        replay.out_dir / ENCOUNTER_DIR / f"{outcome.summary.encounter_id}.png", figure
+    )
+    return ScenarioVerdict(
+        scenario=name, simulation=simulation, replay=replay, outcome=outcome, figure=figure
+    )
+
+
+def run_demo(
+    out_dir: Path | None = None,
+    quiet: bool = True,
+    scenarios_dir: Path = DEFAULT_SCENARIOS_DIR,
+    chart: Path = DEFAULT_CHART,
+    query: Path = DEFAULT_QUERY,
+) -> DemoResult:
+    """Both Greenhopper scenarios: simulate, replay, and the verdicts (module docstring).
+
+    Errors: a missing scenario directory, scenario file, chart or query (``InputFileError``,
+    exit 2); a scenario whose replay has no triggered encounter for own ship
+    (``NoDataError``, exit 3).
+    """
+    target = out_dir if out_dir is not None else DEFAULT_OUT_DIR
+    _require(scenarios_dir, "--scenarios", "directory")
+    _require(chart, "--chart", "file")
+    _require(query, "--query", "file")
+    paths = [scenarios_dir / f"{name}.toml" for name in SCENARIO_NAMES]
+    for path in paths:
+        _require(path, "--scenarios", "file")
+    verdicts = tuple(run_scenario(path, target, chart, query, quiet) for path in paths)
+    return DemoResult(out_dir=target, verdicts=verdicts)
