@@ -290,7 +290,11 @@ def _assemble(
     path: Path,
     parts: Sequence[tuple[NDArray[np.object_], str | NDArray[np.object_], Mapping[str, Any]]],
 ) -> _Features:
-    geometries, classes, drval1, drval2, valsou = [], [], [], [], []
+    geometries: list[NDArray[np.object_]] = []
+    classes: list[NDArray[np.object_]] = []
+    drval1: list[NDArray[np.float64]] = []
+    drval2: list[NDArray[np.float64]] = []
+    valsou: list[NDArray[np.float64]] = []
     for part_geometries, part_class, columns in parts:
         n = len(part_geometries)
         geometries.append(part_geometries)

@@ -284,3 +284,41 @@ def chart_command(
     with _user_errors():
         summary = summarise_chart(charts, draught_m=draught, ukc_m=ukc, out=out, quiet=quiet)
     typer.echo(summary.text, nl=False)
+
+
+@app.command("demo")
+def demo_command(
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", help="Output directory. Default: reports/demo/."),
+    ] = None,
+    scenarios: Annotated[
+        Path,
+        typer.Option(
+            "--scenarios",
+            help="Directory with greenhopper_restricted.toml and greenhopper_not_restricted.toml.",
+        ),
+    ] = Path("fixtures/scenarios"),
+    chart: Annotated[
+        Path,
+        typer.Option("--chart", help="Chart for the replay."),
+    ] = Path("fixtures/charts/aalborg_modelled.geojson"),
+    query: Annotated[
+        Path,
+        typer.Option("--query", help="Query TOML with the paper's parameters."),
+    ] = Path("queries/greenhopper.toml"),
+    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
+) -> None:
+    """The paper's Greenhopper case study: simulate and replay both scenarios, print the verdicts.
+
+    Run it from the repository root (the scenarios, chart and query live in fixtures/ and
+    queries/). Writes the AIS, the replay reports and one figure per scenario to the output
+    directory. Exit code 3 if a scenario gives own ship no triggered encounter.
+
+    Example: colregs9 demo --out reports/demo
+    """
+    from .demo import run_demo
+
+    with _user_errors():
+        result = run_demo(out, quiet=quiet, scenarios_dir=scenarios, chart=chart, query=query)
+    typer.echo(result.text, nl=False)

@@ -86,46 +86,51 @@ def _yes_no(value: bool) -> str:
     return "yes" if value else "no"
 
 
+def verdict_rows(verdict: ScenarioVerdict) -> tuple[tuple[str, str], ...]:
+    """(label, value) of one scenario's verdict, in the order printed."""
+    s = verdict.outcome.summary
+    return (
+        ("trigger (UTC)", s.trigger_utc.strftime("%Y-%m-%d %H:%M:%S")),
+        ("situation", s.situation.value),
+        ("own role under COLREGs", s.own_role_colregs.value),
+        ("target reports restricted", _yes_no(s.target_reports_restricted)),
+        ("target estimated restricted", s.target_estimated_restricted.value),
+        ("rule 9 applied", _yes_no(s.rule9_applied)),
+        ("own role after rule 9", s.own_role_final.value),
+        ("automaton path", s.automaton_path),
+        ("range at trigger", f"{s.range_m_at_trigger:.0f} m"),
+        ("CPA at trigger", f"{s.cpa_m:.0f} m"),
+        ("TCPA at trigger", f"{s.tcpa_s:.0f} s"),
+        ("as in the paper", _yes_no(verdict.as_in_paper)),
+    )
+
+
 def format_demo(result: DemoResult) -> str:
     """The verdict table (one column per scenario) and where the files are."""
-    first = result.verdicts[0].outcome.summary
-    rows: list[tuple[str, list[str]]] = [("", [v.scenario for v in result.verdicts])]
-    fields: list[tuple[str, object]] = [
-        ("trigger (UTC)", lambda s: s.trigger_utc.strftime("%Y-%m-%d %H:%M:%S")),
-        ("situation", lambda s: s.situation.value),
-        ("own role under COLREGs", lambda s: s.own_role_colregs.value),
-        ("target reports restricted", lambda s: _yes_no(s.target_reports_restricted)),
-        ("target estimated restricted", lambda s: s.target_estimated_restricted.value),
-        ("rule 9 applied", lambda s: _yes_no(s.rule9_applied)),
-        ("own role after rule 9", lambda s: s.own_role_final.value),
-        ("automaton path", lambda s: s.automaton_path),
-        ("range at trigger", lambda s: f"{s.range_m_at_trigger:.0f} m"),
-        ("CPA at trigger", lambda s: f"{s.cpa_m:.0f} m"),
-        ("TCPA at trigger", lambda s: f"{s.tcpa_s:.0f} s"),
-    ]
-    for label, cell in fields:
-        rows.append((label, [cell(v.outcome.summary) for v in result.verdicts]))  # type: ignore[operator]
-    rows.append(("as in the paper", [_yes_no(v.as_in_paper) for v in result.verdicts]))
+    columns = [verdict_rows(v) for v in result.verdicts]
+    labels = [label for label, _ in columns[0]]
+    rows = [("", [v.scenario for v in result.verdicts])]
+    rows += [(label, [column[i][1] for column in columns]) for i, label in enumerate(labels)]
     label_width = max(len(label) for label, _ in rows)
     widths = [max(len(cells[i]) for _, cells in rows) for i in range(len(result.verdicts))]
+    first = result.verdicts[0].outcome.summary
     lines = [
-        "Greenhopper case study (the paper's section \"Simulation results\"), modelled chart.",
+        'Greenhopper case study (the paper\'s section "Simulation results"), modelled chart.',
         f"Own ship {first.own_name} (MMSI {first.own_mmsi}); target {first.target_name} "
         f"(MMSI {first.target_mmsi}).",
         "",
     ]
     for label, cells in rows:
-        line = label.ljust(label_width) + "  " + "  ".join(
-            c.ljust(w) for c, w in zip(cells, widths, strict=True)
-        )
-        lines.append(line.rstrip())
-    lines.append("")
-    lines.append(f"Files in {result.out_dir}:")
+        cells_text = "  ".join(c.ljust(w) for c, w in zip(cells, widths, strict=True))
+        lines.append(f"{label.ljust(label_width)}  {cells_text}".rstrip())
+    lines += ["", f"Files in {result.out_dir}:"]
     for verdict in result.verdicts:
-        lines.append(
-            f"  {verdict.scenario}: AIS {verdict.simulation.out_path}, reports "
-            f"{verdict.replay.out_dir}/, figure {verdict.figure}"
-        )
+        lines += [
+            f"  {verdict.scenario}",
+            f"    figure   {verdict.figure}",
+            f"    AIS      {verdict.simulation.out_path}",
+            f"    reports  {verdict.replay.out_dir}/ (encounters.csv, index.md, run.json)",
+        ]
     return "\n".join(lines) + "\n"
 
 
@@ -180,9 +185,7 @@ def run_scenario(
     )
     outcome = _own_outcome(replay, own.mmsi, name)
     figure = out_dir / f"{name}.png"
-    shutil.copyfile(
-        replay.out_dir / ENCOUNTER_DIR / f"{outcome.summary.encounter_id}.png", figure
-    )
+    shutil.copyfile(replay.out_dir / ENCOUNTER_DIR / f"{outcome.summary.encounter_id}.png", figure)
     return ScenarioVerdict(
         scenario=name, simulation=simulation, replay=replay, outcome=outcome, figure=figure
     )

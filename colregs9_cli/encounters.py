@@ -10,7 +10,8 @@
 - ``encounter_series``: one encounter's steps, own ship and target side by side, for the
   COLREGs evaluation, the rule 9 automaton and the reports.
 
-Velocities are over ground: SOG along COG.
+Velocities are over ground: SOG along COG, taken as the grid COG (``cog_grid_deg``, see
+``tracks``) because they are compared with positions in the frame.
 """
 
 from __future__ import annotations
@@ -79,7 +80,11 @@ def trigger_mask(
 def velocity_mps(
     speed_mps: ArrayLike, course_deg: ArrayLike
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(north, east) velocity components of a speed along a course."""
+    """(north, east) velocity components of a speed along a course.
+
+    The components are along the axes the course is measured from: give a grid course
+    (``cog_grid_deg``) for a velocity in the ``LocalFrame``.
+    """
     course_rad = np.radians(np.asarray(course_deg, dtype=float))
     speed = np.asarray(speed_mps, dtype=float)
     return speed * np.cos(course_rad), speed * np.sin(course_rad)
@@ -203,7 +208,7 @@ def find_encounters(
     north = samples["north_m"].to_numpy()[rows]
     east = samples["east_m"].to_numpy()[rows]
     v_n, v_e = velocity_mps(
-        samples["speed_mps"].to_numpy()[rows], samples["cog_deg"].to_numpy()[rows]
+        samples["speed_mps"].to_numpy()[rows], samples["cog_grid_deg"].to_numpy()[rows]
     )
     vessel_ids, vessel = np.unique(samples["mmsi"].to_numpy()[rows], return_inverse=True)
 
@@ -366,6 +371,9 @@ SERIES_VESSEL_COLUMNS: tuple[str, ...] = (
     "cog_deg",
     "heading_deg",
     "course_deg",
+    "cog_grid_deg",
+    "heading_grid_deg",
+    "course_grid_deg",
     "sog_kn",
     "speed_mps",
     "nav_status",
@@ -396,8 +404,8 @@ def encounter_series(
     series.insert(
         1, "timestamp", pd.to_datetime(series["step"] * tracks.step_s, unit="s", utc=True)
     )
-    own_vn, own_ve = velocity_mps(series["own_speed_mps"], series["own_cog_deg"])
-    tgt_vn, tgt_ve = velocity_mps(series["target_speed_mps"], series["target_cog_deg"])
+    own_vn, own_ve = velocity_mps(series["own_speed_mps"], series["own_cog_grid_deg"])
+    tgt_vn, tgt_ve = velocity_mps(series["target_speed_mps"], series["target_cog_grid_deg"])
     series["rel_north_m"] = series["target_north_m"] - series["own_north_m"]
     series["rel_east_m"] = series["target_east_m"] - series["own_east_m"]
     series["range_m"] = np.hypot(series["rel_north_m"], series["rel_east_m"])

@@ -180,8 +180,11 @@ def target_rate_of_swing_deg_per_m(length_m: float | None, params: Manoeuvrabili
     if params.swing_model is SwingModel.FIXED:
         return params.swing_deg_per_m
     lengths, rates = _reference_lengths_and_rates()
-    known_length = length_m is not None and bool(np.isfinite(length_m))
-    if params.swing_model is SwingModel.LOWER_BOUND or not known_length:
+    if (
+        params.swing_model is SwingModel.LOWER_BOUND
+        or length_m is None
+        or not np.isfinite(length_m)
+    ):
         return float(rates.min())
     gap = np.abs(lengths - length_m)
     nearest = gap == gap.min()

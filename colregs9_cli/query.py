@@ -344,7 +344,9 @@ def _region(path: Path, table: dict[str, Any]) -> Region:
         if not given:
             assert polygon is not None
             return Region.from_polygon(polygon)
-        return Region(*(table[k] for k in box_keys), polygon=polygon)
+        return Region(
+            table["lat_min"], table["lat_max"], table["lon_min"], table["lon_max"], polygon=polygon
+        )
     except QueryError as exc:
         raise QueryError(f"{path}: [region] {exc}") from None
 

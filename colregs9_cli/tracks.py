@@ -19,9 +19,9 @@ The rules, in order, per MMSI with reports sorted by time:
 3. **Gaps.** A track is split where consecutive kept reports are more than ``max_gap_s`` apart
    (``gap_splits``).
 4. **Missing SOG/COG.** A null SOG or COG is derived from the movement between the report's
-   neighbours in its segment (previous to next report; one-sided at a segment's ends). A
-   vessel that did not move gets SOG 0 and no COG (null). A one-report segment keeps nulls.
-   A null heading becomes the (possibly derived) COG.
+   neighbours in its segment (previous to next report; one-sided at a segment's ends), turned
+   from grid to true north at the report. A vessel that did not move gets SOG 0 and no COG
+   (null). A one-report segment keeps nulls. A null heading becomes the (possibly derived) COG.
 5. **Resampling.** Each segment is resampled on the absolute UTC grid ``t = k·step_s``
    (Unix epoch), at the grid times inside ``[first report, last report]``: nothing is
    extrapolated. North/east and SOG are linear in time; COG, heading and course are
@@ -30,6 +30,12 @@ The rules, in order, per MMSI with reports sorted by time:
 
 The course used for bearings (``course_deg``) is COG or heading (``CourseSource``); velocity
 always comes from COG and SOG, the motion over ground.
+
+``cog_deg``, ``heading_deg`` and ``course_deg`` are true, for reports. Each has a grid twin
+(``cog_grid_deg`` …) in the frame's own north, ``true − γ`` with γ the meridian convergence at
+the sample (``LocalFrame.grid_convergence_deg``): velocities in the frame and bearings compared
+with frame positions must use the grid twins, or they turn by γ (≈ 2° at the edges of a frame
+centred on all of Denmark, a CPA error of range·sin γ).
 """
 
 from __future__ import annotations
@@ -76,6 +82,9 @@ SAMPLE_COLUMNS: tuple[str, ...] = (
     "cog_deg",
     "heading_deg",
     "course_deg",
+    "cog_grid_deg",
+    "heading_grid_deg",
+    "course_grid_deg",
     "sog_kn",
     "speed_mps",
     "nav_status",
@@ -149,13 +158,13 @@ def build_tracks(
     order, mmsi, t = order[new_time], mmsi[new_time], t[new_time]
     same_time_dropped = reports_in - len(t)
 
-    north, east = frame.to_local(
-        positions["lat_deg"].to_numpy(dtype=float)[order],
-        positions["lon_deg"].to_numpy(dtype=float)[order],
-    )
+    report_lat = positions["lat_deg"].to_numpy(dtype=float)[order]
+    report_lon = positions["lon_deg"].to_numpy(dtype=float)[order]
+    north, east = frame.to_local(report_lat, report_lon)
     keep, jump_split = _drop_jumps(mmsi, t, north, east, params)
     speed_jump_dropped = int((~keep).sum())
     order, mmsi, t, north, east = order[keep], mmsi[keep], t[keep], north[keep], east[keep]
+    report_lat, report_lon = report_lat[keep], report_lon[keep]
     jump_split = jump_split[keep]
 
     first_of_vessel = np.ones(len(t), dtype=bool)
@@ -170,7 +179,13 @@ def build_tracks(
         return pd.to_numeric(positions[name], errors="coerce").to_numpy(dtype=float)[order]
 
     sog_kn, cog_deg = _fill_motion(
-        segment_of_report, t, north, east, column("sog_kn"), column("cog_deg")
+        segment_of_report,
+        t,
+        north,
+        east,
+        frame.grid_convergence_deg(report_lat, report_lon),
+        column("sog_kn"),
+        column("cog_deg"),
     )
     heading_deg = column("heading_deg")
     heading_deg = np.where(np.isnan(heading_deg), cog_deg, heading_deg)
@@ -188,6 +203,9 @@ def build_tracks(
     lat, lon = frame.to_geodetic(samples["north_m"], samples["east_m"])
     samples["lat_deg"] = lat
     samples["lon_deg"] = lon
+    convergence_deg = frame.grid_convergence_deg(lat, lon)
+    for name in ("cog", "heading", "course"):
+        samples[f"{name}_grid_deg"] = wrap_deg(samples[f"{name}_deg"] - convergence_deg)
     samples["speed_mps"] = samples["sog_kn"] * MPS_PER_KNOT
     samples["timestamp"] = pd.to_datetime(samples["t_s"], unit="s", utc=True)
     samples = samples[list(SAMPLE_COLUMNS)]
@@ -290,10 +308,15 @@ def _fill_motion(
     t: NDArray[np.float64],
     north: NDArray[np.float64],
     east: NDArray[np.float64],
+    convergence_deg: NDArray[np.float64],
     sog_kn: NDArray[np.float64],
     cog_deg: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Rule 4: null SOG/COG from the movement between the report's neighbours."""
+    """Rule 4: null SOG/COG from the movement between the report's neighbours.
+
+    The movement's direction is a grid bearing; ``convergence_deg`` (γ at each report) turns
+    it to true like the reported COGs.
+    """
     index = np.arange(len(t))
     previous = np.where(np.r_[False, segment[1:] == segment[:-1]], index - 1, index)
     following = np.where(np.r_[segment[:-1] == segment[1:], False], index + 1, index)
@@ -303,7 +326,8 @@ def _fill_motion(
     distance = np.hypot(d_north, d_east)
     with np.errstate(invalid="ignore", divide="ignore"):
         derived_sog = np.where(dt > 0, distance / dt / MPS_PER_KNOT, np.nan)
-    derived_cog = np.where(distance > 0, wrap_deg(np.degrees(np.arctan2(d_east, d_north))), np.nan)
+    grid_cog = np.degrees(np.arctan2(d_east, d_north))
+    derived_cog = np.where(distance > 0, wrap_deg(grid_cog + convergence_deg), np.nan)
     return (
         np.where(np.isnan(sog_kn), derived_sog, sog_kn),
         np.where(np.isnan(cog_deg), derived_cog, cog_deg),

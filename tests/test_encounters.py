@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from pyproj import Geod
 
 from colregs9_cli import encounters as encounters_module
 from colregs9_cli.encounters import (
@@ -40,7 +41,11 @@ PARAMS = ReplayParams()
 def straight_track(
     mmsi: int, north0_m: float, east0_m: float, cog_deg: float, speed_mps: float, end_s: int
 ) -> pd.DataFrame:
-    """Reports every 10 s of a vessel on a straight line, given in the local frame."""
+    """Reports every 10 s of a vessel on a straight line, given in the local frame.
+
+    ``cog_deg`` is the line's grid direction; the reports carry it as the true COG an AIS
+    transponder would send there (grid + meridian convergence).
+    """
     t = np.arange(0, end_s + 1, 10, dtype=float)
     v_n, v_e = velocity_mps(speed_mps, cog_deg)
     lat, lon = FRAME.to_geodetic(north0_m + v_n * t, east0_m + v_e * t)
@@ -51,7 +56,7 @@ def straight_track(
             "lat_deg": lat,
             "lon_deg": lon,
             "sog_kn": speed_mps * 3600 / 1852,
-            "cog_deg": cog_deg,
+            "cog_deg": FRAME.grid_to_true_deg(cog_deg, lat, lon),
             "heading_deg": np.nan,
             "nav_status": 0.0,
         }
@@ -358,8 +363,14 @@ def test_encounter_series_orients_own_and_target() -> None:
         assert f"own_{column}" in series and f"target_{column}" in series
     first = series.iloc[0]
     assert first["timestamp"] == encounter.trigger
-    assert first["own_cog_deg"] == pytest.approx(180.0)
-    assert first["target_cog_deg"] == pytest.approx(0.0)
+    assert first["own_cog_grid_deg"] == pytest.approx(180.0)
+    assert first["target_cog_grid_deg"] == pytest.approx(0.0, abs=1e-9)
+    # The true COGs, for reports, differ from the grid ones by the convergence where they are.
+    for side in ("own", "target"):
+        convergence_deg = FRAME.grid_convergence_deg(first[f"{side}_lat_deg"], first[f"{side}_lon_deg"])
+        assert (first[f"{side}_cog_deg"] - first[f"{side}_cog_grid_deg"] + 180.0) % 360.0 - 180.0 == (
+            pytest.approx(float(convergence_deg), abs=1e-9)
+        )
     assert first["rel_east_m"] == pytest.approx(-100.0, abs=1e-6)  # own is the eastern ship
     assert first["rel_north_m"] == pytest.approx(-1800.0, abs=1e-6)
     assert first["tcpa_s"] == pytest.approx(encounter.tcpa_s_at_trigger)
@@ -392,8 +403,8 @@ def test_find_encounters_agrees_with_a_direct_computation(seed: int) -> None:
         rel_speed = np.hypot(
             *(
                 np.subtract(
-                    velocity_mps(series["target_speed_mps"], series["target_cog_deg"]),
-                    velocity_mps(series["own_speed_mps"], series["own_cog_deg"]),
+                    velocity_mps(series["target_speed_mps"], series["target_cog_grid_deg"]),
+                    velocity_mps(series["own_speed_mps"], series["own_cog_grid_deg"]),
                 )
             )
         )
@@ -442,3 +453,60 @@ def test_replay_params_from_a_toml_table() -> None:
 def test_replay_params_out_of_range(kwargs: dict[str, object], message: str) -> None:
     with pytest.raises(ParameterError, match=message):
         ReplayParams(**kwargs)  # type: ignore[arg-type]
+
+
+# --- meridian convergence ------------------------------------------------------------------
+
+
+def geodesic_track(
+    mmsi: int, meet_lat: float, meet_lon: float, cog_deg: float, speed_mps: float, meet_s: int
+) -> pd.DataFrame:
+    """Reports every 10 s of a vessel sailing at true ``cog_deg`` through the meeting point
+    at ``meet_s``, built on the ellipsoid (pyproj Geod), not in any projection."""
+    geod = Geod(ellps="WGS84")
+    start_lon, start_lat, start_course = geod.fwd(
+        meet_lon, meet_lat, cog_deg + 180.0, speed_mps * meet_s
+    )
+    t = np.arange(0, 2 * meet_s + 1, 10, dtype=float)
+    lon, lat, _ = geod.fwd(
+        np.full_like(t, start_lon), np.full_like(t, start_lat), np.full_like(t, start_course), speed_mps * t
+    )
+    return pd.DataFrame(
+        {
+            "timestamp": [T0 + pd.Timedelta(seconds=s) for s in t],
+            "mmsi": mmsi,
+            "lat_deg": lat,
+            "lon_deg": lon,
+            "sog_kn": mps_to_knots(speed_mps),
+            "cog_deg": start_course % 360.0,
+            "heading_deg": np.nan,
+            "nav_status": 0.0,
+        }
+    )
+
+
+def test_true_collision_course_far_from_the_central_meridian_has_cpa_zero() -> None:
+    # Two vessels meet at 56° N, 2° of longitude east of the frame's central meridian, where
+    # grid north is 1.66° east of true north. Their tracks are laid on the ellipsoid with true
+    # courses 000° and 270°, so they collide (CPA 0) by construction. The trigger comes at
+    # range ≈ 180 s × 7.3 m/s ≈ 1.3 km, where turning both velocities by 1.66° would move the
+    # CPA by ≈ 38 m.
+    frame = LocalFrame(56.0, 10.0)
+    speed = 5.0
+    own = geodesic_track(1, 56.0, 12.0, 0.0, speed, 600)
+    target = geodesic_track(2, 56.0, 12.0, 270.0, speed, 600)
+    tracks = build_tracks(pd.concat([own, target], ignore_index=True), frame, PARAMS)
+    (encounter,) = find_encounters(tracks, PARAMS, own_mmsi=[1]).encounters
+    assert encounter.triggered
+    assert encounter.tcpa_s_at_trigger == pytest.approx(180.0, abs=1.0)
+    assert encounter.cpa_m_at_trigger == pytest.approx(0.0, abs=2.0)
+    series = encounter_series(tracks, encounter)
+    approaching = series[(series["tcpa_s"] > 0) & (series["range_m"] > 100.0)]
+    assert len(approaching) > 100
+    assert approaching["cpa_m"].max() < 2.0
+    assert approaching["tcpa_s"].to_numpy() == pytest.approx(
+        600.0 - (approaching["step"] - T0_S).to_numpy(), abs=1.0
+    )
+    # The reports keep the true courses.
+    assert series["own_cog_deg"].to_numpy() == pytest.approx(0.0, abs=0.05)
+    assert series["target_cog_deg"].to_numpy() == pytest.approx(270.0, abs=0.05)

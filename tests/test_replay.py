@@ -4,7 +4,8 @@ with a chart where the target is restricted (D3 → D4).
 The CPA/TCPA checks recompute every encounter from the two vessels' raw reports around the
 trigger with plain numpy/pyproj (decoded by the NMEA reader, not by the replay pipeline):
 position linear in time between the bracketing reports, SOG linear, COG along the shorter
-arc (the interpolation rules of DESIGN §5 written out by hand), then
+arc (the interpolation rules of DESIGN §5 written out by hand), the velocity turned from true
+to grid north by projecting a 1 m step along the COG (pyproj Geod), then
 ``TCPA = −p·v/|v|²``, ``CPA = |p + v·TCPA|``.
 """
 
@@ -17,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from pyproj import Proj, Transformer
+from pyproj import Geod, Transformer
 
 from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
@@ -38,6 +39,7 @@ from colregs9_cli.simulate import simulate_scenario
 ROOT = Path(__file__).resolve().parents[1]
 NMEA = ROOT / "fixtures" / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
 KNOT_MPS = 1852.0 / 3600.0
+GEOD = Geod(ellps="WGS84")
 
 # The replay pipeline finds 13 close-quarters pairs in the sample, each reported from both
 # sides. Every one of them is re-checked by hand below (CPA < 150 m, 0 <= TCPA <= 180 s).
@@ -70,14 +72,13 @@ def _state_at(reports: pd.DataFrame, when: pd.Timestamp, to_grid: Transformer) -
     e1, n1 = to_grid.transform(after["lon_deg"], after["lat_deg"])
     sog_mps = (before["sog_kn"] + w * (after["sog_kn"] - before["sog_kn"])) * KNOT_MPS
     turn = (after["cog_deg"] - before["cog_deg"] + 180.0) % 360.0 - 180.0
-    cog_rad = np.radians(before["cog_deg"] + w * turn)
+    north, east = n0 + w * (n1 - n0), e0 + w * (e1 - e0)
+    lon, lat = to_grid.transform(east, north, direction="INVERSE")
+    ahead_lon, ahead_lat, _ = GEOD.fwd(lon, lat, before["cog_deg"] + w * turn, 1.0)
+    ahead_e, ahead_n = to_grid.transform(ahead_lon, ahead_lat)
+    grid_cog_rad = np.arctan2(ahead_e - east, ahead_n - north)
     return np.array(
-        [
-            n0 + w * (n1 - n0),
-            e0 + w * (e1 - e0),
-            sog_mps * np.cos(cog_rad),
-            sog_mps * np.sin(cog_rad),
-        ]
+        [north, east, sog_mps * np.cos(grid_cog_rad), sog_mps * np.sin(grid_cog_rad)]
     )
 
 

@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pytest
+from pyproj import Geod
 
 from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
@@ -208,7 +209,12 @@ def test_missing_sog_and_cog_come_from_the_movement() -> None:
     assert samples.loc[T0_S + 10, "sog_kn"] == pytest.approx(5.0 / MPS_PER_KNOT)
     assert samples.loc[T0_S + 20, "sog_kn"] == pytest.approx(2.75 / MPS_PER_KNOT)
     assert samples.loc[T0_S + 30, "sog_kn"] == pytest.approx(0.5 / MPS_PER_KNOT)
-    assert samples["cog_deg"].to_numpy() == pytest.approx(90.0)
+    # Due grid east; the true COG adds the meridian convergence at the sample (1.4e-3° 100 m
+    # east of this frame's central meridian, hence the tolerance of the true check).
+    assert samples["cog_grid_deg"].to_numpy() == pytest.approx(90.0, abs=1e-9)
+    convergence_deg = FRAME.grid_convergence_deg(samples["lat_deg"], samples["lon_deg"])
+    assert samples["cog_deg"].to_numpy() == pytest.approx(90.0 + convergence_deg, abs=1e-9)
+    assert samples["cog_deg"].to_numpy() == pytest.approx(90.0, abs=2e-3)
 
 
 def test_a_vessel_that_did_not_move_gets_no_course() -> None:
@@ -307,3 +313,47 @@ def test_real_nmea_sample(fixtures_dir: Path) -> None:
     assert tracks.samples["mmsi"].nunique() == 1438
     split_vessels = tracks.samples.groupby("mmsi")["segment_id"].nunique()
     assert split_vessels[split_vessels > 1].to_dict() == {219601000: 4}
+
+
+def test_grid_courses_far_from_the_central_meridian() -> None:
+    # A vessel at 56° N, 2° east of the frame's central meridian (convergence ≈ 2°·sin 56° ≈
+    # 1.66°), sailing from true 045° along a geodesic laid with pyproj Geod, each report's COG
+    # the geodesic's azimuth there (045.00° to 045.02°); heading 050°. The report at
+    # t = 100 s has no COG, so it is derived from the movement.
+    frame = LocalFrame(56.0, 10.0)
+    geod = Geod(ellps="WGS84")
+    t = np.arange(0.0, 301.0, 10.0)
+    start_lon, start_lat = 12.0, 56.0
+    lon, lat, back_azimuth_deg = geod.fwd(
+        np.full_like(t, start_lon), np.full_like(t, start_lat), np.full_like(t, 45.0), 6.0 * t
+    )
+    azimuth_along_deg = (np.asarray(back_azimuth_deg) + 180.0) % 360.0
+    cog = azimuth_along_deg.copy()
+    cog[10] = np.nan
+    positions = pd.DataFrame(
+        {
+            "timestamp": [T0 + pd.Timedelta(seconds=s) for s in t],
+            "mmsi": 219000001,
+            "lat_deg": lat,
+            "lon_deg": lon,
+            "sog_kn": 6.0 / MPS_PER_KNOT,
+            "cog_deg": cog,
+            "heading_deg": 50.0,
+            "nav_status": 0,
+        }
+    )
+    samples = build_tracks(positions, frame, ReplayParams(), CourseSource.HEADING).samples
+    by_time = samples.set_index("t_s")
+    # The derived COG is true: the ellipsoidal azimuth from the previous to the next report.
+    azimuth_deg, _, _ = geod.inv(lon[9], lat[9], lon[11], lat[11])
+    assert by_time.loc[T0_S + 100, "cog_deg"] == pytest.approx(azimuth_deg, abs=0.01)
+    reported = samples[~samples["t_s"].between(T0_S + 91, T0_S + 109)]
+    assert reported["cog_deg"].to_numpy() == pytest.approx(45.0, abs=0.02)
+    assert reported["course_deg"].to_numpy() == pytest.approx(50.0)
+    # The grid COG is the direction the vessel moves in the frame, 1.66° left of the true one.
+    motion_deg = np.degrees(np.arctan2(np.diff(samples["east_m"]), np.diff(samples["north_m"])))
+    assert samples["cog_grid_deg"].to_numpy()[1:] == pytest.approx(motion_deg, abs=1e-3)
+    assert reported["cog_grid_deg"].to_numpy() == pytest.approx(45.0 - 1.66, abs=0.01)
+    turn = samples["heading_deg"] - samples["heading_grid_deg"]
+    assert turn.to_numpy() == pytest.approx(samples["cog_deg"] - samples["cog_grid_deg"])
+    assert (samples["course_grid_deg"] == samples["heading_grid_deg"]).all()

@@ -52,6 +52,7 @@ import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from datetime import UTC
+from typing import cast
 
 import numpy as np
 import pandas as pd
@@ -66,6 +67,7 @@ from pyais.messages import (
     MessageType19,
     MessageType24PartA,
     MessageType24PartB,
+    MessageType24PartBAuxiliaryCraft,
     MessageType27,
     NMEASentenceFactory,
     Payload,
@@ -145,6 +147,14 @@ def _required_bits() -> dict[int, int]:
         24: _bits_through(MessageType24PartA, "shipname"),
     }
 
+
+# pyais's decode() is typed as the union of every message class (and misses the auxiliary
+# craft variant of type 24 part B); the message type fixes which of these it returns.
+_PositionMessage = MessageType1 | MessageType18 | MessageType19 | MessageType27
+_StaticMessage = (
+    MessageType5 | MessageType24PartA | MessageType24PartB | MessageType24PartBAuxiliaryCraft
+)
+_Type24Message = MessageType24PartA | MessageType24PartB | MessageType24PartBAuxiliaryCraft
 
 _REQUIRED_BITS = _required_bits()
 _TYPE24_PART_B_BITS = _bits_through(MessageType24PartB, "to_starboard")
@@ -358,26 +368,28 @@ class _NmeaReader:
         except (AISBaseException, ValueError) as err:
             self._reject_message(RejectReason.UNPARSEABLE, line_no, f"undecodable ({err})", raw)
             return
-        if msg_type == 24 and decoded.partno not in (0, 1):
-            self._reject_message(
-                RejectReason.UNPARSEABLE, line_no, f"type 24 part number {decoded.partno}", raw
-            )
-            return
-        if msg_type == 24 and decoded.partno == 1 and n_bits < _TYPE24_PART_B_BITS:
-            self._reject_message(
-                RejectReason.UNPARSEABLE,
-                line_no,
-                f"type 24 part B payload has {n_bits} bits, needs {_TYPE24_PART_B_BITS}",
-                raw,
-            )
-            return
+        if msg_type == 24:
+            partno = cast(_Type24Message, decoded).partno
+            if partno not in (0, 1):
+                self._reject_message(
+                    RejectReason.UNPARSEABLE, line_no, f"type 24 part number {partno}", raw
+                )
+                return
+            if partno == 1 and n_bits < _TYPE24_PART_B_BITS:
+                self._reject_message(
+                    RejectReason.UNPARSEABLE,
+                    line_no,
+                    f"type 24 part B payload has {n_bits} bits, needs {_TYPE24_PART_B_BITS}",
+                    raw,
+                )
+                return
         if msg_type in POSITION_TYPES:
-            self._add_position(decoded, sentence, msg_type, timestamp)
+            self._add_position(cast(_PositionMessage, decoded), sentence, msg_type, timestamp)
         else:
-            _append_static(self.statics, decoded, msg_type, timestamp)
+            _append_static(self.statics, cast(_StaticMessage, decoded), msg_type, timestamp)
 
     def _add_position(
-        self, decoded: Payload, sentence: AISSentence, msg_type: int, timestamp: int
+        self, decoded: _PositionMessage, sentence: AISSentence, msg_type: int, timestamp: int
     ) -> None:
         columns = self.positions
         columns.timestamp.append(timestamp)
@@ -436,7 +448,9 @@ def _append_static_fields(columns: _Columns, decoded: Payload) -> None:
     columns.imo.append(getattr(decoded, "imo", None))
 
 
-def _append_static(columns: _Columns, decoded: Payload, msg_type: int, timestamp: int) -> None:
+def _append_static(
+    columns: _Columns, decoded: _StaticMessage, msg_type: int, timestamp: int
+) -> None:
     columns.timestamp.append(timestamp)
     columns.mmsi.append(decoded.mmsi)
     columns.msg_type.append(msg_type)

@@ -1,0 +1,77 @@
+"""LocalFrame: the meridian convergence and true ↔ grid bearings, checked numerically."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from pyproj import Geod
+
+from colregs9_cli.geo import LocalFrame
+
+FRAME = LocalFrame(56.0, 11.0)
+GEOD = Geod(ellps="WGS84")
+
+
+def grid_bearing_deg(frame: LocalFrame, lat: float, lon: float, true_deg: float) -> float:
+    """Grid bearing of a 10 m geodesic leaving (lat, lon) at ``true_deg``, measured in the frame."""
+    end_lon, end_lat, _ = GEOD.fwd(lon, lat, true_deg, 10.0)
+    north, east = frame.to_local([lat, end_lat], [lon, end_lon])
+    return float(np.degrees(np.arctan2(east[1] - east[0], north[1] - north[0])))
+
+
+@pytest.mark.parametrize("lon", [7.0, 9.0, 10.5, 11.0, 11.5, 13.0, 15.5])
+@pytest.mark.parametrize("lat", [54.5, 56.0, 57.8])
+@pytest.mark.parametrize("true_deg", [0.0, 45.0, 200.0])
+def test_grid_bearing_is_true_minus_convergence(lat: float, lon: float, true_deg: float) -> None:
+    convergence_deg = float(FRAME.grid_convergence_deg(lat, lon))
+    measured = grid_bearing_deg(FRAME, lat, lon, true_deg)
+    assert (measured - (true_deg - convergence_deg) + 180.0) % 360.0 - 180.0 == pytest.approx(
+        0.0, abs=1e-4
+    )
+    assert float(FRAME.true_to_grid_deg(true_deg, lat, lon)) == pytest.approx(
+        (true_deg - convergence_deg) % 360.0, abs=1e-12
+    )
+
+
+def test_convergence_is_zero_on_the_central_meridian_and_changes_sign_across_it() -> None:
+    lat = np.array([54.5, 56.0, 57.8])
+    assert FRAME.grid_convergence_deg(lat, np.full(3, 11.0)) == pytest.approx(0.0, abs=1e-12)
+    east = FRAME.grid_convergence_deg(lat, np.full(3, 13.0))
+    west = FRAME.grid_convergence_deg(lat, np.full(3, 9.0))
+    assert (east > 0.0).all() and (west < 0.0).all()
+    assert east == pytest.approx(-west, rel=1e-9)
+
+
+@pytest.mark.parametrize("d_lon", [-3.0, -1.0, 0.5, 2.0, 4.0])
+@pytest.mark.parametrize("lat", [54.5, 56.0, 57.8])
+def test_convergence_is_about_delta_lon_times_sin_lat(d_lon: float, lat: float) -> None:
+    # The leading term of the series (Snyder 1987, eq. 8-15 with the second term < 0.3 % here).
+    approximation = d_lon * np.sin(np.radians(lat))
+    assert float(FRAME.grid_convergence_deg(lat, 11.0 + d_lon)) == pytest.approx(
+        approximation, rel=3e-3
+    )
+
+
+def test_danish_edges_reach_about_two_degrees() -> None:
+    # The national frame is centred near 11° E; Bornholm (15° E) and the North Sea coast
+    # (8° E) lie 2.5°–4° of longitude away.
+    assert abs(float(FRAME.grid_convergence_deg(55.1, 15.0))) == pytest.approx(3.28, abs=0.01)
+    assert abs(float(FRAME.grid_convergence_deg(56.0, 8.1))) == pytest.approx(2.40, abs=0.01)
+
+
+def test_bearings_wrap_and_round_trip() -> None:
+    lat, lon = np.array([56.5, 56.5, 55.0]), np.array([13.0, 9.0, 12.0])
+    true_deg = np.array([1.0, 359.0, 180.0])
+    grid = FRAME.true_to_grid_deg(true_deg, lat, lon)
+    assert ((grid >= 0.0) & (grid < 360.0)).all()
+    assert grid[0] == pytest.approx(360.0 + 1.0 - 1.668, abs=1e-3)  # east: crosses north
+    assert grid[1] == pytest.approx(359.0 + 1.668 - 360.0, abs=1e-3)  # west: crosses north
+    assert FRAME.grid_to_true_deg(grid, lat, lon) == pytest.approx(true_deg, abs=1e-9)
+
+
+def test_unknown_positions_and_bearings_stay_unknown() -> None:
+    convergence = FRAME.grid_convergence_deg([56.0, np.nan, 56.0], [13.0, 12.0, np.nan])
+    assert np.isfinite(convergence[0]) and np.isnan(convergence[1:]).all()
+    assert np.isnan(FRAME.true_to_grid_deg(np.nan, 56.0, 13.0))
+    assert FRAME.grid_convergence_deg([], []).shape == (0,)
+    assert FRAME.grid_convergence_deg(56.0, [9.0, 13.0]).shape == (2,)
