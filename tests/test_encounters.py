@@ -367,10 +367,12 @@ def test_encounter_series_orients_own_and_target() -> None:
     assert first["target_cog_grid_deg"] == pytest.approx(0.0, abs=1e-9)
     # The true COGs, for reports, differ from the grid ones by the convergence where they are.
     for side in ("own", "target"):
-        convergence_deg = FRAME.grid_convergence_deg(first[f"{side}_lat_deg"], first[f"{side}_lon_deg"])
-        assert (first[f"{side}_cog_deg"] - first[f"{side}_cog_grid_deg"] + 180.0) % 360.0 - 180.0 == (
-            pytest.approx(float(convergence_deg), abs=1e-9)
+        convergence_deg = FRAME.grid_convergence_deg(
+            first[f"{side}_lat_deg"], first[f"{side}_lon_deg"]
         )
+        assert (
+            first[f"{side}_cog_deg"] - first[f"{side}_cog_grid_deg"] + 180.0
+        ) % 360.0 - 180.0 == (pytest.approx(float(convergence_deg), abs=1e-9))
     assert first["rel_east_m"] == pytest.approx(-100.0, abs=1e-6)  # own is the eastern ship
     assert first["rel_north_m"] == pytest.approx(-1800.0, abs=1e-6)
     assert first["tcpa_s"] == pytest.approx(encounter.tcpa_s_at_trigger)
@@ -469,7 +471,10 @@ def geodesic_track(
     )
     t = np.arange(0, 2 * meet_s + 1, 10, dtype=float)
     lon, lat, _ = geod.fwd(
-        np.full_like(t, start_lon), np.full_like(t, start_lat), np.full_like(t, start_course), speed_mps * t
+        np.full_like(t, start_lon),
+        np.full_like(t, start_lat),
+        np.full_like(t, start_course),
+        speed_mps * t,
     )
     return pd.DataFrame(
         {
