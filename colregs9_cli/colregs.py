@@ -107,12 +107,17 @@ class Kinematics:
 
     @classmethod
     def from_frame(cls, frame: pd.DataFrame, prefix: str) -> Kinematics:
-        """From columns ``<prefix>north_m`` … (e.g. ``encounter_series`` with ``own_``)."""
+        """From columns ``<prefix>north_m`` … (e.g. ``encounter_series`` with ``own_``).
+
+        Courses are taken in the frame's grid north (``<prefix>cog_grid_deg``), because the
+        bearings between vessels are measured on grid positions; true courses would put every
+        sector boundary off by the meridian convergence.
+        """
         return cls(
             north_m=frame[f"{prefix}north_m"].to_numpy(dtype=float),
             east_m=frame[f"{prefix}east_m"].to_numpy(dtype=float),
-            cog_deg=frame[f"{prefix}cog_deg"].to_numpy(dtype=float),
-            heading_deg=frame[f"{prefix}heading_deg"].to_numpy(dtype=float),
+            cog_deg=frame[f"{prefix}cog_grid_deg"].to_numpy(dtype=float),
+            heading_deg=frame[f"{prefix}heading_grid_deg"].to_numpy(dtype=float),
             speed_mps=frame[f"{prefix}speed_mps"].to_numpy(dtype=float),
         )
 

@@ -405,9 +405,15 @@ def evaluate_encounter(
     trigger_assessment: ManoeuvrabilityAssessment | None = None
     nav_statuses = [_nav_status(v) for v in series["target_nav_status"].tolist()]
     timestamps = series["timestamp"].tolist()
+    # The chart lives in the local frame, so the arcs start from the grid course.
     target_state = {
-        name: series[f"target_{name}"].to_numpy(dtype=float)
-        for name in ("north_m", "east_m", "course_deg", "speed_mps")
+        name: series[f"target_{column}"].to_numpy(dtype=float)
+        for name, column in (
+            ("north_m", "north_m"),
+            ("east_m", "east_m"),
+            ("course_deg", "course_grid_deg"),
+            ("speed_mps", "speed_mps"),
+        )
     }
     for row, (own_role, nav_status) in enumerate(zip(g_a.own_role, nav_statuses, strict=True)):
         reaches_d3 = own_role is Role.STAND_ON and nav_status not in restricted_statuses
@@ -466,8 +472,8 @@ def evaluate_encounter(
         )
 
     tcpa_s = float(trigger["tcpa_s"])
-    own_vn, own_ve = velocity_mps(trigger["own_speed_mps"], trigger["own_cog_deg"])
-    tgt_vn, tgt_ve = velocity_mps(trigger["target_speed_mps"], trigger["target_cog_deg"])
+    own_vn, own_ve = velocity_mps(trigger["own_speed_mps"], trigger["own_cog_grid_deg"])
+    tgt_vn, tgt_ve = velocity_mps(trigger["target_speed_mps"], trigger["target_cog_grid_deg"])
     vessels = tracks.vessels
     summary = EncounterSummary(
         encounter_id=encounter.encounter_id,

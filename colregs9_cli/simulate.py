@@ -141,7 +141,8 @@ def simulate_vessel(vessel: VesselSpec, frame: LocalFrame, times_s: np.ndarray) 
         lat_deg=lat_deg,
         lon_deg=lon_deg,
         sog_kn=np.where(arrived, 0.0, np.asarray(vessel.speed_kn)[leg]),
-        cog_deg=leg_course_deg[leg],
+        # AIS reports true COG; the leg's direction in the frame is a grid bearing.
+        cog_deg=frame.grid_to_true_deg(leg_course_deg[leg], lat_deg, lon_deg),
     )
 
 
