@@ -1,0 +1,44 @@
+"""The stage tables documented in queries/README.md load, and their values are the defaults."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import tomllib
+from pathlib import Path
+
+from colregs9_cli.colregs import ColregsParams, colregs_params_from_table
+from colregs9_cli.manoeuvrability import ManoeuvrabilityParams
+from colregs9_cli.replay_params import ReplayParams, replay_params_from_table
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _documented_tables() -> dict[str, dict[str, object]]:
+    text = (ROOT / "queries" / "README.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```toml\n(.*?)```", text, flags=re.DOTALL)
+    stage_blocks = [b for b in blocks if "[manoeuvrability]" in b and "[replay]" in b]
+    assert len(stage_blocks) == 1, "queries/README.md must document the stage tables once"
+    return tomllib.loads(stage_blocks[0])
+
+
+def test_documented_stage_tables_are_the_defaults() -> None:
+    tables = _documented_tables()
+    assert set(tables) == {"manoeuvrability", "colregs", "replay"}
+    where = "queries/README.md"
+    assert ManoeuvrabilityParams.from_table(tables["manoeuvrability"], where) == (
+        ManoeuvrabilityParams()
+    )
+    assert colregs_params_from_table(tables["colregs"], where) == ColregsParams()
+    assert replay_params_from_table(tables["replay"], where) == ReplayParams()
+
+
+def test_every_parameter_is_documented() -> None:
+    tables = _documented_tables()
+    for name, cls in (
+        ("manoeuvrability", ManoeuvrabilityParams),
+        ("colregs", ColregsParams),
+        ("replay", ReplayParams),
+    ):
+        fields = {f.name for f in dataclasses.fields(cls) if f.init}
+        assert set(tables[name]) == fields, f"[{name}] in queries/README.md != {cls.__name__}"
