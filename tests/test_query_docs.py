@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def _documented_tables() -> dict[str, dict[str, object]]:
     text = (ROOT / "queries" / "README.md").read_text(encoding="utf-8")
     blocks = re.findall(r"```toml\n(.*?)```", text, flags=re.DOTALL)
-    stage_blocks = [b for b in blocks if "[manoeuvrability]" in b and "[replay]" in b]
+    stage_blocks = [b for b in blocks if "swing_model" in b and "restricted_nav_statuses" in b]
     assert len(stage_blocks) == 1, "queries/README.md must document the stage tables once"
     return tomllib.loads(stage_blocks[0])
 
