@@ -22,8 +22,9 @@ vessel when its sounding ``VALSOU`` is shallower than draught + UKC, or when it 
 sounding (unknown depth is treated as dangerous, as ECDIS does).
 
 Navigable water for draught T is the union of depth areas with ``DRVAL1 >= T + UKC``, minus
-land and structures, minus the blocking hazards. Coverage (the charted extent) is the union
-of every depth area, land and structure: a position outside it is "unknown", never "deep".
+land and structures, with gaps narrower than ``SLIVER_TOLERANCE_M`` closed (see there), minus
+the blocking hazards. Coverage (the charted extent) is the union of every depth area, land and
+structure: a position outside it is "unknown", never "deep".
 """
 
 from __future__ import annotations
@@ -46,6 +47,13 @@ from .errors import ChartError, ParameterError
 from .geo import LocalFrame
 
 HAZARD_RADIUS_M = 10.0
+# Depth areas that should meet often leave slivers of gap between them (or of land filling the
+# gap) once a chart has been converted between coordinate systems or rounded: an edge that is
+# one segment in one area and two in its neighbour does not stay straight under a projection.
+# Millimetres to centimetres wide, they would punch spurious holes into the navigable water and
+# make any ellipse over them "restricted". Gaps narrower than this are closed; nothing a vessel
+# could be stopped by is that narrow.
+SLIVER_TOLERANCE_M = 0.1
 S57_OPEN_OPTIONS = {"UPDATES": "APPLY", "SPLIT_MULTIPOINT": "ON", "ADD_SOUNDG_DEPTH": "ON"}
 S57_SUFFIXES = (".000",)
 VECTOR_SUFFIXES = (".geojson", ".json", ".gpkg")
@@ -123,7 +131,7 @@ class Chart:
         if key not in self._water:
             required_m = draught_m + ukc_m
             deep = shapely.union_all(self.depth_areas[self.drval1_m >= required_m])
-            water = shapely.difference(deep, self.land)
+            water = _close_slivers(shapely.difference(deep, self.land))
             blocking = self._blocking_hazards(required_m)
             if not shapely.is_empty(blocking):
                 water = shapely.difference(water, blocking)
@@ -170,6 +178,17 @@ class Chart:
             return self.hazards
         blocking = np.isnan(self.hazard_depth_m) | (self.hazard_depth_m < required_m)
         return shapely.union_all(self.hazard_areas[blocking])
+
+
+def _close_slivers(water: Any) -> Any:
+    """``water`` with gaps and holes narrower than ``SLIVER_TOLERANCE_M`` closed.
+
+    A morphological closing (grow by half the tolerance, shrink back) with mitred joins, so
+    corners stay sharp and the rest of the outline does not move.
+    """
+    half_m = SLIVER_TOLERANCE_M / 2.0
+    grown = shapely.buffer(water, half_m, join_style="mitre", mitre_limit=10.0)
+    return shapely.buffer(grown, -half_m, join_style="mitre", mitre_limit=10.0)
 
 
 @dataclass(frozen=True)

@@ -15,24 +15,35 @@ paper's region R, ``colregs9_cli.geo.LocalFrame``):
    (LNDARE). The two closed rings that cross the fjord at 9.91°E and 9.92°E are the
    railway bridge and Limfjordsbroen: they span the water and are left out, so the water
    under them stays water.
-2. Depth bands from the distance ``d`` to land: 0–2 m for ``d < 40 m``, 2–4 m for
-   ``40 <= d < 100 m``, 4–6 m beyond. Limfjorden is a shallow fjord; most of it is
-   modelled as 4–6 m.
+2. Depth bands from the distance ``d`` to land: 0–2 m for ``d < 15 m``, 2–4 m for
+   ``15 <= d < 35 m``, 4–6 m beyond. Limfjorden is a shallow fjord; most of it is
+   modelled as 4–6 m. Its banks at Aalborg and Nørresundby are largely quays and
+   dredged, so the 4 m line is modelled close in; a vessel drawing less than 4 m (the
+   paper's mean draught, 3.2 m) has the fjord but for a 35 m margin.
 3. A natural deep basin, 6–12 m, only where the fjord is wide: the points within
-   ``BASIN_REACH_M`` of the water that is at least ``BASIN_CORE_M`` from land. Where the
-   fjord is narrower than ``2 * BASIN_CORE_M`` (the bridges and the stretch east of them)
-   there is no basin, so a vessel that needs more than 4 m of water (DRVAL1 >= 5 m for a
-   5 m draught) is confined to the fairway there; where the fjord widens (the arm
-   north-east of region R, and west of the bridges towards Egholm) the basin gives room
-   to manoeuvre.
+   ``BASIN_REACH_M`` of the water that is at least ``BASIN_CORE_M`` from land (so it
+   reaches to 100 m off the shore). Where the fjord is narrower than ``2 * BASIN_CORE_M``
+   (the bridges and the stretch east of them) there is no basin, so a vessel that needs
+   more than 4 m of water (DRVAL1 >= 5 m for a 5 m draught) is confined to the fairway
+   there; where the fjord widens (the arm north-east of region R, and west of the
+   bridges towards Egholm) the basin gives room to manoeuvre.
 4. A dredged fairway (DRGARE, 8 m) of width ``2 * FAIRWAY_HALF_WIDTH_M`` along the
    hand-drawn centreline ``FAIRWAY_CENTRELINE`` (lon, lat), which follows the middle of
    the fjord through the bridges, north of Egholm in the west. It is kept at least
-   ``SHALLOW_MARGIN_M`` off the land.
+   ``FAIRWAY_OFF_LAND_M`` off the land.
 5. The depth areas partition the water: the fairway first, then the basin minus the
-   fairway, then each band minus both. Geometry is simplified to ``SIMPLIFY_M`` and
-   coordinates are rounded to 1e-6° (about 0.1 m), so the file is small and the output is
-   byte-for-byte reproducible.
+   fairway, then each band minus both. Geometry is simplified to ``SIMPLIFY_M``.
+6. An exact partition in lon/lat. Transforming each area to lon/lat and rounding it on
+   its own would leave millimetre gaps and overlaps between neighbours (an edge that one
+   area has as one segment and its neighbour as two does not stay straight under the
+   projection), and those gaps would punch holes into the navigable water. So the
+   boundaries of all areas and of the chart box are transformed, snapped ONCE to a
+   ``GRID_DEG`` grid (about 1 cm) and noded together, and polygonized into faces; every
+   face takes the attributes of the area it lies in (a face left in a sliver between two
+   areas joins the nearest one; a face outside the water is land), and each area is
+   the union of its faces. Neighbours therefore share their edges vertex for vertex, the
+   file is byte-for-byte reproducible, and ``tests/test_aalborg_chart.py`` checks that the
+   areas neither overlap nor leave holes.
 
 Run: ``python scripts/make_aalborg_chart.py [OUT.geojson]``.
 """
@@ -62,15 +73,17 @@ CHART_BOX = (9.85, 57.02, 9.998, 57.09)  # lon_min, lat_min, lon_max, lat_max
 WATER_SEED = (9.925, 57.0535)  # lon, lat: mid-fjord just east of Limfjordsbroen
 BRIDGE_FEATURES = (1, 2)  # indices of the bridge rings in the coastline file
 
-SHALLOW_MARGIN_M = 40.0
-BAND_LIMITS_M = ((0.0, 40.0, 0.0, 2.0), (40.0, 100.0, 2.0, 4.0), (100.0, None, 4.0, 6.0))
+# (near_m, far_m, DRVAL1, DRVAL2): distance from land → depth band
+BAND_LIMITS_M = ((0.0, 15.0, 0.0, 2.0), (15.0, 35.0, 2.0, 4.0), (35.0, None, 4.0, 6.0))
 BASIN_CORE_M = 300.0
 BASIN_REACH_M = 200.0
 BASIN_DEPTH_M = (6.0, 12.0)
 FAIRWAY_HALF_WIDTH_M = 60.0
 FAIRWAY_DEPTH_M = (8.0, 10.0)
+FAIRWAY_OFF_LAND_M = 40.0
 SIMPLIFY_M = 2.0
-DECIMALS = 6
+GRID_DEG = 1e-7  # ~0.6 cm east, 1.1 cm north at 57°N
+DECIMALS = 7
 
 # lon, lat: the middle of the fjord from the west edge (north of Egholm) to the east edge
 FAIRWAY_CENTRELINE = (
@@ -128,14 +141,37 @@ def _to_lon_lat(geom: BaseGeometry, frame: LocalFrame) -> BaseGeometry:
     return shapely.transform(geom, unproject)
 
 
-def _polygons(geom: BaseGeometry) -> MultiPolygon:
-    """Only the areal parts of ``geom`` (overlays can leave slivers of lines and points)."""
-    parts: list[Polygon] = []
-    for part in getattr(geom, "geoms", [geom]):
-        if isinstance(part, Polygon) and not part.is_empty and part.area > 0.0:
-            parts.append(part)
-        elif isinstance(part, MultiPolygon):
-            parts.extend(p for p in part.geoms if p.area > 0.0)
+def _partition(
+    areas_ll: list[BaseGeometry], water_ll: BaseGeometry
+) -> tuple[list[MultiPolygon], MultiPolygon]:
+    """The areas and the land as an exact partition of the chart box on the ``GRID_DEG``
+    grid: one noding of every boundary, polygonized, each face given to one area or to land.
+    """
+    chart_box = box(*CHART_BOX)
+    linework = shapely.union_all(
+        [*(shapely.boundary(area) for area in areas_ll), chart_box.exterior], grid_size=GRID_DEG
+    )
+    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(linework)))
+    points = shapely.point_on_surface(faces)
+    inside = shapely.contains(chart_box, points)
+    faces, points = faces[inside], points[inside]
+    tree = shapely.STRtree(areas_ll)
+    # the first area holding the face: areas come in priority order, and where two
+    # overlap it is by a rounding sliver
+    land = len(areas_ll)
+    owner = np.full(len(faces), land)
+    face_index, area_index = tree.query(points, predicate="within")
+    np.minimum.at(owner, face_index, area_index)
+    gaps = np.flatnonzero((owner == land) & shapely.contains(water_ll, points))
+    gap_index, nearest_area = tree.query_nearest(points[gaps], all_matches=False)
+    owner[gaps[gap_index]] = nearest_area
+    geometries = [_union(faces[owner == index]) for index in range(len(areas_ll))]
+    return geometries, _union(faces[owner == land])
+
+
+def _union(faces: np.ndarray) -> MultiPolygon:
+    merged = shapely.union_all(faces, grid_size=GRID_DEG)
+    parts = [part for part in shapely.get_parts(merged) if isinstance(part, Polygon)]
     return MultiPolygon(parts)
 
 
@@ -172,7 +208,7 @@ def build_chart(coastline: dict[str, Any]) -> dict[str, Any]:
     fairway = (
         centreline_m.buffer(FAIRWAY_HALF_WIDTH_M)
         .simplify(SIMPLIFY_M)
-        .intersection(off_land(SHALLOW_MARGIN_M))
+        .intersection(off_land(FAIRWAY_OFF_LAND_M))
     )
     basin_outline = off_land(BASIN_CORE_M).buffer(BASIN_REACH_M).simplify(SIMPLIFY_M)
     basin = basin_outline.intersection(water_m).difference(fairway)
@@ -187,16 +223,12 @@ def build_chart(coastline: dict[str, Any]) -> dict[str, Any]:
         taken = unary_union([taken, band])
         areas.append(("DEPARE", drval1, drval2, band))
 
-    chart_box = box(*CHART_BOX)
-    features: list[dict[str, Any]] = []
-    water_parts: list[BaseGeometry] = []
-    for objl, drval1, drval2, geom_m in areas:
-        geom_ll = shapely.set_precision(_to_lon_lat(geom_m, frame), 10.0**-DECIMALS)
-        geom_ll = _polygons(geom_ll.intersection(chart_box))
-        water_parts.append(geom_ll)
+    geometries_ll, land_ll = _partition(
+        [_to_lon_lat(geom_m, frame) for *_, geom_m in areas], _to_lon_lat(water_m, frame)
+    )
+    features = [_feature("LNDARE", None, None, land_ll)]
+    for (objl, drval1, drval2, _), geom_ll in zip(areas, geometries_ll, strict=True):
         features.append(_feature(objl, drval1, drval2, geom_ll))
-    land_ll = shapely.set_precision(chart_box.difference(unary_union(water_parts)), 10.0**-DECIMALS)
-    features.insert(0, _feature("LNDARE", None, None, _polygons(land_ll)))
     return {
         "type": "FeatureCollection",
         "name": "aalborg_modelled",

@@ -250,3 +250,43 @@ def test_draw_assessment_colours_ellipses_by_flag(enc: Chart) -> None:
         figure.canvas.draw()
     finally:
         plt.close(figure)
+
+
+def _two_squares(tmp_path: Path, gap_m: float) -> Chart:
+    """Two 100 m depth squares side by side (east–west), ``gap_m`` apart, in a metric CRS."""
+    utm_box = shapely.box(500_000.0, 6_300_000.0, 500_100.0, 6_300_100.0)
+    east = shapely.affinity.translate(utm_box, xoff=100.0 + gap_m)
+    features = [
+        _feature("DEPARE", shapely.geometry.mapping(square), DRVAL1=5.0, DRVAL2=10.0)
+        for square in (utm_box, east)
+    ]
+    path = tmp_path / f"gap-{gap_m}.geojson"
+    path.write_text(
+        json.dumps(
+            {
+                "type": "FeatureCollection",
+                "crs": {"type": "name", "properties": {"name": "urn:ogc:def:crs:EPSG::32632"}},
+                "features": features,
+            }
+        )
+    )
+    return load_chart([path])
+
+
+def test_a_sliver_gap_between_depth_areas_is_closed(tmp_path: Path) -> None:
+    # 1 cm: the kind of seam a coordinate conversion leaves; closed (SLIVER_TOLERANCE_M 0.1 m)
+    chart = _two_squares(tmp_path, 0.01)
+    water = chart.navigable_water(5.0)
+    assert shapely.get_num_geometries(water) == 1
+    assert shapely.get_num_interior_rings(water) == 0
+    # the closing adds the seam (1 cm x 100 m) and moves nothing else
+    squares_m2 = shapely.area(chart.depth_areas).sum()
+    assert water.area == pytest.approx(squares_m2 + 0.01 * 100.0, abs=0.05)
+    assert shapely.difference(water, chart.coverage).area == pytest.approx(1.0, abs=0.05)
+
+
+def test_a_real_gap_between_depth_areas_stays(tmp_path: Path) -> None:
+    chart = _two_squares(tmp_path, 1.0)
+    water = chart.navigable_water(5.0)
+    assert shapely.get_num_geometries(water) == 2
+    assert water.area == pytest.approx(shapely.area(chart.depth_areas).sum(), abs=1e-6)

@@ -17,8 +17,10 @@ matplotlib.use("Agg")
 
 import numpy as np
 import shapely
+from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.collections import PatchCollection
+from matplotlib.colors import ListedColormap
 from matplotlib.patches import PathPatch
 from matplotlib.path import Path as MplPath
 
@@ -31,7 +33,15 @@ WATER_EDGE_COLOUR = "#00c853"
 RESTRICTED_COLOUR = "tab:red"
 CLEAR_COLOUR = "tab:blue"
 UNKNOWN_COLOUR = "0.5"
-DEPTH_CMAP = "Blues"
+# The pale half of "Blues": deep water stays light enough for the blue (clear) ellipses.
+DEPTH_CMAP = ListedColormap(colormaps["Blues"](np.linspace(0.0, 0.45, 256)), name="depth")
+DEPTH_LABEL = "DRVAL1, shallowest depth (m)"
+# Drawing order: the chart at the bottom (0-2), then tracks drawn by callers (below 3), the
+# ellipses above any track, the restricted ones above the clear ones, and the arcs on top.
+ELLIPSE_ZORDER = 3.0
+RESTRICTED_ZORDER = 3.2
+ARC_ZORDER = 4.0
+ELLIPSE_LINEWIDTH = 0.8
 
 
 def _ring_path(coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -88,9 +98,10 @@ def draw_chart(ax: Axes, chart: Chart, draught_m: float | None, ukc_m: float = 0
         water_patches, _ = _patches([chart.navigable_water(draught_m, ukc_m)])
         water = PatchCollection(
             water_patches,
-            facecolor=(0.2, 0.85, 0.35, 0.25),
+            # Outlined, not filled: a tint would shift the depth colours off the colour bar.
+            facecolor="none",
             edgecolor=WATER_EDGE_COLOUR,
-            linewidth=1.6,
+            linewidth=1.8,
             zorder=2,
         )
         water.set_gid("navigable-water")
@@ -113,20 +124,22 @@ def draw_assessment(ax: Axes, assessment: ManoeuvrabilityAssessment) -> None:
             style,
             color="black",
             linewidth=0.8,
-            zorder=4,
+            zorder=ARC_ZORDER,
             label=f"{arc} arc",
         )
+    restricted = assessment.restricted & assessment.covered
+    clear = ~assessment.restricted & assessment.covered
     groups = (
-        ("restricted-ellipses", assessment.restricted & assessment.covered, RESTRICTED_COLOUR),
-        ("clear-ellipses", ~assessment.restricted & assessment.covered, CLEAR_COLOUR),
-        ("unknown-ellipses", ~assessment.covered, UNKNOWN_COLOUR),
+        ("restricted-ellipses", restricted, RESTRICTED_COLOUR, RESTRICTED_ZORDER),
+        ("clear-ellipses", clear, CLEAR_COLOUR, ELLIPSE_ZORDER),
+        ("unknown-ellipses", ~assessment.covered, UNKNOWN_COLOUR, ELLIPSE_ZORDER),
     )
-    for gid, selected, colour in groups:
+    for gid, selected, colour, zorder in groups:
         if not selected.any():
             continue
         patches, _ = _patches(assessment.ellipses[selected])
         ellipses = PatchCollection(
-            patches, facecolor="none", edgecolor=colour, linewidth=0.5, zorder=3
+            patches, facecolor="none", edgecolor=colour, linewidth=ELLIPSE_LINEWIDTH, zorder=zorder
         )
         ellipses.set_gid(gid)
         ellipses.set_label(gid.replace("-", " "))

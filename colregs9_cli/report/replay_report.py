@@ -23,9 +23,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from .atomic import save_figure, write_csv, write_json, write_text
-from .chart_plot import draw_assessment, draw_chart
+from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart
 
 if TYPE_CHECKING:
     from ..chart import Chart
@@ -37,8 +38,16 @@ ENCOUNTER_DIR = "encounters"
 INDEX_NAME = "index.md"
 MANIFEST_NAME = "run.json"
 
-OWN_COLOUR = "tab:red"
+# The paper marks own ship at TCPA with a red dot and the target with a black one. Own ship's
+# track is dark orange so that it does not hide the red (restricted) ellipses.
+OWN_DOT_COLOUR = "tab:red"
+OWN_TRACK_COLOUR = "darkorange"
 TARGET_COLOUR = "black"
+# Tracks under the ellipses; markers above everything.
+TRACK_ZORDER = ELLIPSE_ZORDER - 0.5
+MARKER_ZORDER = 6.0
+# Direction-of-travel arrows at these fractions of each track's length.
+ARROW_FRACTIONS = (0.2, 0.5, 0.8)
 # The smallest view: half a side of 200 m, so that a short encounter still shows its setting.
 ZOOM_MIN_HALF_WIDTH_M = 200.0
 
@@ -175,44 +184,184 @@ def _zoom_to_encounter(ax: Any, outcome: EncounterOutcome) -> None:
     ax.set_ylim(centre_north - half, centre_north + half)
 
 
+def trigger_positions_m(outcome: EncounterOutcome) -> tuple[tuple[float, float], ...]:
+    """Own ship's and the target's (north, east) at the trigger: the first row of the series."""
+    trigger = outcome.series.iloc[0]
+    return (
+        (float(trigger["own_north_m"]), float(trigger["own_east_m"])),
+        (float(trigger["target_north_m"]), float(trigger["target_east_m"])),
+    )
+
+
+def direction_arrows(
+    track: pd.DataFrame, fractions: tuple[float, ...] = ARROW_FRACTIONS
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Arrow positions (east, north) along a track and unit directions (east, north) of travel.
+
+    Each direction is the chord over 4 % of the track's length around the point, so that the
+    jitter between AIS positions does not turn an arrow. Empty when the track does not move.
+    """
+    east = track["east_m"].to_numpy(dtype=float)
+    north = track["north_m"].to_numpy(dtype=float)
+    keep = np.isfinite(east) & np.isfinite(north)
+    east, north = east[keep], north[keep]
+    along_m = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(east), np.diff(north)))])
+    empty = np.empty(0)
+    if len(along_m) < 2 or along_m[-1] <= 0.0:
+        return empty, empty, empty, empty
+    at_m = np.asarray(fractions) * along_m[-1]
+    half_chord_m = 0.02 * along_m[-1]
+    behind_m, ahead_m = at_m - half_chord_m, at_m + half_chord_m
+    d_east = np.interp(ahead_m, along_m, east) - np.interp(behind_m, along_m, east)
+    d_north = np.interp(ahead_m, along_m, north) - np.interp(behind_m, along_m, north)
+    length_m = np.hypot(d_east, d_north)
+    moved = length_m > 0.0
+    return (
+        np.interp(at_m, along_m, east)[moved],
+        np.interp(at_m, along_m, north)[moved],
+        d_east[moved] / length_m[moved],
+        d_north[moved] / length_m[moved],
+    )
+
+
+def _draw_track(
+    ax: Any, track: pd.DataFrame, colour: str, linestyle: str, name: str, gid: str
+) -> None:
+    """A vessel's track over the encounter with small arrows (``gid``) for its direction."""
+    ax.plot(
+        track["east_m"],
+        track["north_m"],
+        color=colour,
+        linewidth=1.4,
+        linestyle=linestyle,
+        zorder=TRACK_ZORDER,
+        label=name,
+    )
+    east, north, unit_east, unit_north = direction_arrows(track)
+    if len(east):
+        arrows = ax.quiver(
+            east,
+            north,
+            unit_east,
+            unit_north,
+            color=colour,
+            angles="xy",
+            scale_units="inches",
+            scale=4.0,  # 0.25 in long, whatever the zoom
+            width=0.006,
+            headwidth=4.0,
+            headlength=4.5,
+            headaxislength=4.0,
+            pivot="mid",
+            zorder=TRACK_ZORDER + 0.1,
+        )
+        arrows.set_gid(gid)
+
+
+def _draw_positions(
+    ax: Any,
+    name: str,
+    at_trigger_m: tuple[float, float],
+    at_tcpa_m: tuple[float, float],
+    dot_colour: str,
+    marker_colour: str,
+) -> None:
+    """The position at the trigger (hollow), the predicted one at TCPA (dot), and between them
+    the constant-velocity prediction (dotted)."""
+    (trigger_north, trigger_east), (tcpa_north, tcpa_east) = at_trigger_m, at_tcpa_m
+    ax.plot(
+        [trigger_east, tcpa_east],
+        [trigger_north, tcpa_north],
+        ":",
+        color=dot_colour,
+        linewidth=1.0,
+        zorder=MARKER_ZORDER - 0.1,
+        label=f"_{name} prediction",
+    )
+    ax.plot(
+        trigger_east,
+        trigger_north,
+        "s",
+        markersize=9,
+        markerfacecolor="none",
+        markeredgecolor=marker_colour,
+        markeredgewidth=2.0,
+        zorder=MARKER_ZORDER,
+        label=f"{name} at trigger",
+    )
+    ax.plot(
+        tcpa_east,
+        tcpa_north,
+        "o",
+        color=dot_colour,
+        markersize=7,
+        zorder=MARKER_ZORDER,
+        label=f"{name} at TCPA",
+    )
+
+
+def _legend_below(figure: Figure, ax: Any) -> None:
+    """A compact legend under the axes, so that it covers nothing: one column for own ship,
+    one for the target, and two for the chart and the assessment."""
+    handles, labels = ax.get_legend_handles_labels()
+    entries = list(zip(handles, labels, strict=True))
+    own = [e for e in entries if e[1].startswith("own ship")]
+    target = [e for e in entries if e[1].startswith("target")]
+    arcs_and_water = [e for e in entries if e[1].endswith("arc") or e[1].startswith("navigable")]
+    ellipses = [e for e in entries if e[1].endswith("ellipses")]
+    columns = [c for c in (own, target, arcs_and_water, ellipses) if c]
+    rows = max(len(c) for c in columns)
+    blank = (Line2D([], [], linestyle="none"), "")
+    # matplotlib fills a legend column by column: pad each to the same height.
+    padded = [entry for c in columns for entry in c + [blank] * (rows - len(c))]
+    figure.legend(
+        [h for h, _ in padded],
+        [label for _, label in padded],
+        loc="outside lower center",
+        ncols=len(columns),
+        fontsize="small",
+        frameon=False,
+    )
+
+
 def encounter_figure(outcome: EncounterOutcome, chart: Chart | None, ukc_m: float) -> Figure:
     """The paper's result figure for one encounter, in the run's local frame (east, north).
 
-    The chart background (depth areas, land, navigable water for the target's draught) when a
-    chart covers the run, both tracks over the encounter, both vessels' predicted positions at
-    TCPA from the trigger (own ship red, target black), and the target's projected arcs with
-    red (restricted) and blue (clear) ellipses at the trigger.
+    The chart background (depth areas with a DRVAL1 colour bar, land, navigable water for the
+    target's draught) when a chart covers the run; both tracks over the encounter with arrows
+    for the direction of travel (own ship dark orange, target black dashed); both vessels at
+    the trigger (hollow squares) and predicted at TCPA from the trigger (own ship red dot,
+    target black dot); and the target's projected arcs with red (restricted) and blue (clear)
+    ellipses at the trigger. The legend sits under the axes.
     """
     s = outcome.summary
-    figure, ax = plt.subplots(figsize=(8, 8), layout="constrained")
+    figure, ax = plt.subplots(figsize=(8.5, 8.8), layout="constrained")
     if chart is not None:
-        draw_chart(ax, chart, s.target_draught_m, ukc_m)
-    ax.plot(
-        outcome.own_track["east_m"],
-        outcome.own_track["north_m"],
-        color=OWN_COLOUR,
-        linewidth=1.2,
-        label=f"own ship {s.own_mmsi}",
+        depths = draw_chart(ax, chart, s.target_draught_m, ukc_m)
+        figure.colorbar(depths, ax=ax, label=DEPTH_LABEL, shrink=0.6, pad=0.02)
+    _draw_track(
+        ax, outcome.own_track, OWN_TRACK_COLOUR, "-", f"own ship {s.own_mmsi}", "own-direction"
     )
-    ax.plot(
-        outcome.target_track["east_m"],
-        outcome.target_track["north_m"],
-        color=TARGET_COLOUR,
-        linewidth=1.2,
-        linestyle="--",
-        label=f"target {s.target_mmsi}",
+    _draw_track(
+        ax,
+        outcome.target_track,
+        TARGET_COLOUR,
+        "--",
+        f"target {s.target_mmsi}",
+        "target-direction",
     )
     draw_assessment(ax, outcome.assessment)
-    own_north, own_east = outcome.own_at_tcpa_m
-    target_north, target_east = outcome.target_at_tcpa_m
-    ax.plot(own_east, own_north, "o", color=OWN_COLOUR, markersize=7, label="own ship at TCPA")
-    ax.plot(
-        target_east, target_north, "o", color=TARGET_COLOUR, markersize=7, label="target at TCPA"
+    own_at_trigger_m, target_at_trigger_m = trigger_positions_m(outcome)
+    _draw_positions(
+        ax, "own ship", own_at_trigger_m, outcome.own_at_tcpa_m, OWN_DOT_COLOUR, OWN_TRACK_COLOUR
+    )
+    _draw_positions(
+        ax, "target", target_at_trigger_m, outcome.target_at_tcpa_m, TARGET_COLOUR, TARGET_COLOUR
     )
     _zoom_to_encounter(ax, outcome)
     ax.set_xlabel("east (m)")
     ax.set_ylabel("north (m)")
-    ax.legend(loc="best", fontsize="small")
+    _legend_below(figure, ax)
     ax.set_title(f"{s.encounter_id}\n{_verdict(outcome)}", fontsize="medium")
     return figure
 
