@@ -225,6 +225,8 @@ def test_draw_chart_shades_depth_areas_by_drval1(enc: Chart) -> None:
         assert set(by_gid) == {"depth-areas", "land", "navigable-water"}
         np.testing.assert_array_equal(by_gid["depth-areas"].get_array(), enc.drval1_m)
         assert len(by_gid["depth-areas"].get_paths()) == 249
+        # Outlined, not tinted, so the depth colours match the colour bar.
+        assert len(by_gid["navigable-water"].get_facecolor()) == 0
         figure.canvas.draw()
     finally:
         plt.close(figure)
@@ -243,6 +245,8 @@ def test_draw_assessment_colours_ellipses_by_flag(enc: Chart) -> None:
         red = assessment.restricted & assessment.covered
         assert len(by_gid["restricted-ellipses"].get_paths()) == red.sum() > 0
         assert len(by_gid["clear-ellipses"].get_paths()) == (~red).sum() > 0
+        # The few restricted ellipses are not hidden under the clear ones.
+        assert by_gid["restricted-ellipses"].get_zorder() > by_gid["clear-ellipses"].get_zorder()
         lines = {line.get_label(): line for line in ax.get_lines()}
         np.testing.assert_allclose(
             lines["cw arc"].get_xdata(), assessment.east_m[assessment.arc == "cw"]

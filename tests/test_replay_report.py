@@ -14,8 +14,14 @@ import pytest
 
 from colregs9_cli.chart import load_chart
 from colregs9_cli.replay import ENCOUNTER_COLUMNS, SERIES_COLUMNS, run_replay
-from colregs9_cli.report.replay_report import encounter_figure
+from colregs9_cli.report.chart_plot import DEPTH_LABEL, RESTRICTED_COLOUR
+from colregs9_cli.report.replay_report import (
+    direction_arrows,
+    encounter_figure,
+    trigger_positions_m,
+)
 from colregs9_cli.simulate import simulate_scenario
+from colregs9_cli.units import MPS_PER_KNOT
 
 ROOT = Path(__file__).resolve().parents[1]
 NMEA = ROOT / "fixtures" / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
@@ -161,16 +167,18 @@ def test_png_smoke_render(run) -> None:
 def test_figure_plots_the_tracks_and_the_positions_at_tcpa(run) -> None:
     (outcome,) = run.encounters
     figure = encounter_figure(outcome, chart=None, ukc_m=0.5)
-    (ax,) = figure.axes
+    (ax,) = figure.axes  # no chart, no colour bar
     lines = {line.get_label(): line for line in ax.get_lines()}
     own = lines[f"own ship {OWN}"]
     np.testing.assert_allclose(own.get_xdata(), outcome.own_track["east_m"])
     np.testing.assert_allclose(own.get_ydata(), outcome.own_track["north_m"])
     target = lines[f"target {outcome.summary.target_mmsi}"]
     np.testing.assert_allclose(target.get_ydata(), outcome.target_track["north_m"])
+    # The paper's dots: own ship red, target black; own ship's track is not the restricted red.
     own_dot = lines["own ship at TCPA"]
     target_dot = lines["target at TCPA"]
     assert own_dot.get_color() == "tab:red" and target_dot.get_color() == "black"
+    assert own.get_color() not in ("tab:red", RESTRICTED_COLOUR)
     # The dots are apart by the CPA: both predicted from the trigger to TCPA.
     gap = np.hypot(
         own_dot.get_xdata()[0] - target_dot.get_xdata()[0],
@@ -204,7 +212,8 @@ def test_figure_draws_one_ellipse_per_projected_position(restricted) -> None:
     assessment = outcome.assessment
     chart = load_chart([MODELLED_CHART], restricted.frame)
     figure = encounter_figure(outcome, chart, ukc_m=0.0)
-    (ax,) = figure.axes
+    ax, colour_bar = figure.axes
+    assert colour_bar.get_ylabel() == DEPTH_LABEL
     red = _collection(ax, "restricted-ellipses")
     blue = _collection(ax, "clear-ellipses")
     assert len(red.get_paths()) == int((assessment.restricted & assessment.covered).sum()) > 0
@@ -227,3 +236,97 @@ def test_figure_without_a_chart_marks_every_ellipse_unknown(run) -> None:
     assert len(unknown.get_paths()) == len(outcome.assessment.arc)
     assert _collection(ax, "restricted-ellipses") is None
     assert _collection(ax, "depth-areas") is None
+
+
+def test_figure_marks_both_vessels_at_the_trigger(run) -> None:
+    (outcome,) = run.encounters
+    s = outcome.summary
+    figure = encounter_figure(outcome, chart=None, ukc_m=0.0)
+    (ax,) = figure.axes
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    first = outcome.series.iloc[0]
+    assert first["timestamp"] == s.trigger_utc
+    for name, side, speed_kn, at_tcpa in (
+        ("own ship", "own", s.own_speed_kn_at_trigger, lines["own ship at TCPA"]),
+        ("target", "target", s.target_speed_kn_at_trigger, lines["target at TCPA"]),
+    ):
+        marker = lines[f"{name} at trigger"]
+        assert marker.get_markerfacecolor() == "none"  # hollow, unlike the dots at TCPA
+        east, north = marker.get_xdata()[0], marker.get_ydata()[0]
+        assert (east, north) == (first[f"{side}_east_m"], first[f"{side}_north_m"])
+        # The trigger position is on the vessel's track...
+        track = outcome.own_track if side == "own" else outcome.target_track
+        assert (np.hypot(track["east_m"] - east, track["north_m"] - north) < 1e-9).any()
+        # ...and the dot at TCPA is where the vessel gets to from it in TCPA at its speed.
+        sailed_m = np.hypot(at_tcpa.get_xdata()[0] - east, at_tcpa.get_ydata()[0] - north)
+        assert sailed_m == pytest.approx(speed_kn * MPS_PER_KNOT * s.tcpa_s, rel=1e-6)
+    assert trigger_positions_m(outcome) == (
+        (first["own_north_m"], first["own_east_m"]),
+        (first["target_north_m"], first["target_east_m"]),
+    )
+
+
+def test_direction_arrows_on_a_hand_worked_track() -> None:
+    # 100 m east, then 100 m north: at a quarter of the way the ship heads east, at
+    # three quarters north; the arrows sit on the track.
+    track = pd.DataFrame({"east_m": [0.0, 50.0, 100.0, 100.0], "north_m": [0.0, 0.0, 0.0, 100.0]})
+    east, north, unit_east, unit_north = direction_arrows(track, (0.25, 0.75))
+    np.testing.assert_allclose(east, [50.0, 100.0])
+    np.testing.assert_allclose(north, [0.0, 50.0])
+    np.testing.assert_allclose(unit_east, [1.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(unit_north, [0.0, 1.0], atol=1e-12)
+    # Reversed, the arrows turn round.
+    back = direction_arrows(track.iloc[::-1], (0.25, 0.75))
+    np.testing.assert_allclose(back[2], [0.0, -1.0], atol=1e-12)
+    np.testing.assert_allclose(back[3], [-1.0, 0.0], atol=1e-12)
+    # A ship that does not move gets no arrow.
+    still = pd.DataFrame({"east_m": [5.0, 5.0], "north_m": [7.0, 7.0]})
+    assert all(len(a) == 0 for a in direction_arrows(still))
+
+
+def test_figure_arrows_show_the_direction_of_travel(run) -> None:
+    (outcome,) = run.encounters
+    figure = encounter_figure(outcome, chart=None, ukc_m=0.0)
+    (ax,) = figure.axes
+    for gid, track in (
+        ("own-direction", outcome.own_track),
+        ("target-direction", outcome.target_track),
+    ):
+        arrows = _collection(ax, gid)
+        east, north, unit_east, unit_north = direction_arrows(track)
+        assert len(east) == 3
+        np.testing.assert_allclose(arrows.X, east)
+        np.testing.assert_allclose(arrows.Y, north)
+        np.testing.assert_allclose(arrows.U, unit_east)
+        np.testing.assert_allclose(arrows.V, unit_north)
+        # Each arrow points from the part of the track sailed before it to the part after.
+        for x, y, u, v in zip(east, north, unit_east, unit_north, strict=True):
+            nearest = int(np.argmin(np.hypot(track["east_m"] - x, track["north_m"] - y)))
+            later = track.iloc[min(nearest + 5, len(track) - 1)]
+            earlier = track.iloc[max(nearest - 5, 0)]
+            step = (later["east_m"] - earlier["east_m"], later["north_m"] - earlier["north_m"])
+            assert u * step[0] + v * step[1] > 0.9 * np.hypot(*step)
+
+
+def test_figure_layout_keeps_the_plot_clear(restricted) -> None:
+    (outcome,) = restricted.encounters
+    chart = load_chart([MODELLED_CHART], restricted.frame)
+    figure = encounter_figure(outcome, chart, ukc_m=0.0)
+    ax = figure.axes[0]
+    # A colour bar keys the depth shading.
+    depths = _collection(ax, "depth-areas")
+    assert depths.colorbar is not None and depths.colorbar.ax in figure.axes
+    assert depths.colorbar.ax.get_ylabel() == DEPTH_LABEL
+    # The legend is below the axes, not on them.
+    assert ax.get_legend() is None
+    (legend,) = figure.legends
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    assert legend.get_window_extent(renderer).y1 <= ax.get_window_extent(renderer).y0
+    labels = [t.get_text() for t in legend.get_texts()]
+    assert {"own ship at trigger", "target at trigger", "restricted ellipses"} <= set(labels)
+    # The ellipses are drawn over the tracks.
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    track_zorder = lines[f"own ship {GREENHOPPER}"].get_zorder()
+    assert _collection(ax, "restricted-ellipses").get_zorder() > track_zorder
+    assert _collection(ax, "clear-ellipses").get_zorder() > track_zorder
