@@ -33,14 +33,12 @@ import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from . import __version__
 from .ais.ledger import RejectReason, RejectsLedger
 from .ais.load import AisData, load_ais
 from .chart import Chart, chart_bounds_wgs84, load_chart
@@ -64,7 +62,8 @@ from .manoeuvrability import (
 from .progress import progress_bar, progress_enabled
 from .query import Query, everything_query, load_query
 from .replay_params import ReplayParams, replay_params_from_table
-from .report.replay_report import format_summary, jsonable, write_replay_reports
+from .report.manifest import inputs_manifest, jsonable, query_manifest, run_header
+from .report.replay_report import format_summary, write_replay_reports
 from .rule9 import Rule9Assessment, assess_rule9
 from .tracks import Tracks, build_tracks
 from .units import signed_angle_deg
@@ -587,26 +586,11 @@ def build_manifest(
 ) -> dict[str, Any]:
     """The content of run.json."""
     return {
-        "tool": "colregs9",
-        "version": __version__,
-        "command": "replay",
-        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
-        "query": {
-            "name": query.name,
-            "source": None if query.source is None else str(query.source),
-            "region": jsonable(query.region),
-        },
+        **run_header("replay"),
+        "query": query_manifest(query),
         "frame": {"lat0_deg": frame.lat0_deg, "lon0_deg": frame.lon0_deg},
         "parameters": jsonable(params),
-        "inputs": [
-            {
-                "path": str(item.path),
-                "sha256": item.sha256,
-                "layout": item.layout,
-                "rows_read": item.rows_read,
-            }
-            for item in data.inputs
-        ],
+        "inputs": inputs_manifest(data.inputs),
         "charts": [str(p) for p in chart_paths],
         "ledger": ledger.to_dict(),
         "ledger_balanced": ledger.balanced,

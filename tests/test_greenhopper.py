@@ -255,7 +255,9 @@ def test_the_target_is_on_own_ships_port_side_at_the_trigger(demo: DemoRun, name
     relative_deg = (bearing_deg - trigger["own_course_deg"]) % 360.0
     # port side, forward of the overtaking sector (abaft 112.5° on the port side)
     assert 247.5 < relative_deg < 360.0
-    assert trigger["beta_deg"] == pytest.approx(relative_deg, abs=1e-6)
+    # The replay compares grid bearings with grid courses; this check uses the true course,
+    # which differs by the meridian convergence, Δlon·sin(lat) ≈ 0.04° across this frame.
+    assert trigger["beta_deg"] == pytest.approx(relative_deg, abs=0.05)
     # the target crosses from port to starboard ahead of own ship: rule 15 makes her give way
     assert trigger["target_role_colregs"] == "give-way"
 
@@ -385,50 +387,48 @@ def _scenario_with_target_draught(name: str, draught_m: float, tmp_path: Path) -
 def test_mean_draught_target_on_the_modelled_chart(demo: DemoRun, tmp_path: Path) -> None:
     """The target at the paper's mean draught 3.2 m (Table 1) instead of 5.0 m.
 
-    The paper argues that such a target is not restricted. On the MODELLED chart she still
-    is, for a reason in the chart, not in the estimator: depths grow with the distance from
-    land (2–4 m from 40 m off the shore, 4–6 m from 100 m), and in the wide arm the 6–12 m
-    basin reaches out to the 4 m contour, so water navigable for 3.2 m (DRVAL1 >= 4 m) and
-    for 5.0 m (DRVAL1 >= 6 m) share the same edge, 100 m off the shore. The restricted
-    target's starboard arc brings her ellipse within 53 m of the Nørresundby shore, inside
-    that edge, for either draught. The clear target stays clear.
+    As the paper argues, she is no longer restricted, and the chart shows why. Her projected
+    positions do not depend on her draught, only the water they are tested against does: at
+    5.0 m she needs DRVAL1 >= 6 m, the basin and the fairway, which end 100 m off the shore
+    in the wide arm; at 3.2 m the 4–6 m band counts too, and it reaches to 35 m off the
+    shore. The ellipses that are red at 5.0 m come within about 50 m of the Nørresundby
+    shore: out of 6 m water, inside 4 m water. The clear target stays clear.
     """
     restricted = run_scenario(
         _scenario_with_target_draught(RESTRICTED, 3.2, tmp_path), tmp_path, CHART, QUERY
     )
     summary = restricted.outcome.summary
     assert summary.target_draught_m == 3.2 and not summary.target_dimensions_defaulted
-    assert summary.target_estimated_restricted is Restriction.RESTRICTED
-    assert summary.automaton_path == "D1>D2>D3>D4"
+    assert summary.target_estimated_restricted is Restriction.NOT_RESTRICTED
+    assert not summary.rule9_applied
+    assert summary.own_role_final.value == "stand-on"
+    assert summary.automaton_path == "D1>D2>D3>D1"
 
     at_5_m = _replay(demo.out_dir / f"simulate-{RESTRICTED}.csv", tmp_path / "at-5-m")
     assessment, assessment_5_m = restricted.outcome.assessment, at_5_m.encounters[0].assessment
-    assert np.array_equal(assessment.restricted, assessment_5_m.restricted)
+    assert np.array_equal(assessment.north_m, assessment_5_m.north_m)
+    assert not assessment.restricted.any() and assessment_5_m.restricted.any()
 
-    # why: around every red ellipse the 3.2 m water ends where the 5 m water ends, at the
-    # 4 m contour 100 m off the land
+    # why: every ellipse that is red at 5.0 m lies in 3.2 m water, and what it lacks at
+    # 5.0 m is the 4–6 m band, 35–100 m off the shore
     chart = load_chart([CHART], restricted.replay.frame)
     water_3_2, water_5 = chart.navigable_water(3.2), chart.navigable_water(5.0)
-    red = np.flatnonzero(assessment.restricted)
+    red = np.flatnonzero(assessment_5_m.restricted)
     ellipses = ellipse_polygons(
-        assessment.north_m[red],
-        assessment.east_m[red],
-        assessment.heading_deg[red],
-        assessment.a_m,
-        assessment.b_m,
+        assessment_5_m.north_m[red],
+        assessment_5_m.east_m[red],
+        assessment_5_m.heading_deg[red],
+        assessment_5_m.a_m,
+        assessment_5_m.b_m,
     )
     nearest_land_m = min(chart.land.distance(e) for e in ellipses)
-    assert 40.0 < nearest_land_m < 100.0
-    band_2_4_m = shapely.union_all(chart.depth_areas[chart.drval1_m == 2.0])
+    assert 35.0 < nearest_land_m < 100.0
+    band_4_6_m = shapely.union_all(chart.depth_areas[chart.drval1_m == 4.0])
     for ellipse in ellipses:
-        # what the ellipse lacks is 2–4 m water, not navigable at 3.2 m either (up to the
-        # chart's seams between depth areas, millimetres wide)
-        lacking = ellipse.difference(water_3_2)
+        assert ellipse.difference(water_3_2).area < 1e-6
+        lacking = ellipse.difference(water_5)
         assert lacking.area > 1.0
-        assert lacking.difference(band_2_4_m).area < 0.5
-        edge = water_3_2.boundary.intersection(ellipse)
-        assert chart.land.distance(edge) == pytest.approx(100.0, abs=2.5)
-    assert water_3_2.area > water_5.area  # elsewhere the 4–6 m band does add water
+        assert lacking.difference(band_4_6_m).area < 1e-6
 
     clear = run_scenario(
         _scenario_with_target_draught(NOT_RESTRICTED, 3.2, tmp_path), tmp_path, CHART, QUERY

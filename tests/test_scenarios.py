@@ -142,7 +142,7 @@ def _restricted_text() -> str:
         (lambda t: t.replace("nav_status = 0\n", "nav_status = 0\ncolour = 1\n", 1), "'colour'"),
         # own ship's first waypoint moved ashore into Nørresundby
         (lambda t: t.replace("[57.075500, 9.966800]", "[57.065000, 9.925000]"), "waypoint 0"),
-        # the target's (5 m draught) first waypoint moved onto own ship's 2–4 m start
+        # the target's (5 m draught) first waypoint moved onto own ship's start, in the 4–6 m band
         (lambda t: t.replace("[57.077358, 9.980206]", "[57.075500, 9.966800]"), "MODEL TARGET"),
         (lambda t: t.replace("speed_kn = 7.0", "speed_kn = [7.0, 7.0]"), "speed_kn has 2 values"),
     ],

@@ -6,11 +6,7 @@ this module only lays them out.
 
 from __future__ import annotations
 
-import dataclasses
 import math
-from collections.abc import Mapping
-from datetime import UTC, datetime
-from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -23,8 +19,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from .. import __version__
 from .atomic import save_figure, write_csv, write_json, write_text
+from .manifest import inputs_manifest, query_manifest, run_header
 
 if TYPE_CHECKING:
     from ..ais.load import AisData
@@ -146,52 +142,12 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     return figure
 
 
-def _jsonable(value: Any) -> Any:
-    """Query parts (dataclasses, enums, paths, datetimes, geometries) as JSON values."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
-    if isinstance(value, Enum):
-        return value.value
-    if isinstance(value, Mapping):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple | set | frozenset):
-        items = [_jsonable(v) for v in value]
-        return sorted(items, key=str) if isinstance(value, set | frozenset) else items
-    if isinstance(value, datetime):
-        return value.isoformat()
-    if isinstance(value, float) and math.isnan(value):
-        return None
-    if value is None or isinstance(value, str | int | float | bool):
-        return value
-    if hasattr(value, "wkt"):
-        return value.wkt
-    return str(value)
-
-
 def build_manifest(result: StatsResult, query: Query, data: AisData) -> dict[str, Any]:
     """The content of run.json: what was read, what the query kept, and the result."""
     return {
-        "tool": "colregs9",
-        "version": __version__,
-        "command": "stats",
-        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
-        "query": {
-            "name": query.name,
-            "description": query.description,
-            "source": None if query.source is None else str(query.source),
-            "region": _jsonable(query.region),
-            "time": _jsonable(query.time),
-            "vessels": _jsonable(query.vessels),
-        },
-        "inputs": [
-            {
-                "path": str(item.path),
-                "sha256": item.sha256,
-                "layout": item.layout,
-                "rows_read": item.rows_read,
-            }
-            for item in data.inputs
-        ],
+        **run_header("stats"),
+        "query": query_manifest(query),
+        "inputs": inputs_manifest(data.inputs),
         "rows_read": data.ledger.rows_read,
         "rows_in_query": data.rows_in_query,
         "ledger": data.ledger.to_dict(),

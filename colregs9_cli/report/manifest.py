@@ -1,0 +1,77 @@
+"""The parts every run.json shares: tool and version, the query, the inputs, JSON values."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from datetime import UTC, datetime
+from enum import Enum
+from typing import TYPE_CHECKING, Any
+
+import pandas as pd
+
+from .. import __version__
+
+if TYPE_CHECKING:
+    from ..ais.load import InputFile
+    from ..query import Query
+
+
+def jsonable(value: Any) -> Any:
+    """Parameters and inputs (dataclasses, enums, paths, times, sets, geometries) as JSON."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {
+            f.name: jsonable(getattr(value, f.name)) for f in dataclasses.fields(value) if f.repr
+        }
+    if isinstance(value, Enum):
+        return value.value
+    if isinstance(value, Mapping):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, set | frozenset):
+        return sorted((jsonable(v) for v in value), key=str)
+    if isinstance(value, list | tuple):
+        return [jsonable(v) for v in value]
+    if isinstance(value, datetime | pd.Timestamp):
+        return value.isoformat()
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    if value is None or isinstance(value, str | int | float | bool):
+        return value
+    if hasattr(value, "wkt"):
+        return value.wkt
+    if hasattr(value, "item"):  # numpy scalars
+        return jsonable(value.item())
+    return str(value)
+
+
+def run_header(command: str) -> dict[str, Any]:
+    return {
+        "tool": "colregs9",
+        "version": __version__,
+        "command": command,
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+
+
+def query_manifest(query: Query) -> dict[str, Any]:
+    return {
+        "name": query.name,
+        "description": query.description,
+        "source": None if query.source is None else str(query.source),
+        "region": jsonable(query.region),
+        "time": jsonable(query.time),
+        "vessels": jsonable(query.vessels),
+    }
+
+
+def inputs_manifest(inputs: Sequence[InputFile]) -> list[dict[str, Any]]:
+    return [
+        {
+            "path": str(item.path),
+            "sha256": item.sha256,
+            "layout": item.layout,
+            "rows_read": item.rows_read,
+        }
+        for item in inputs
+    ]
