@@ -55,17 +55,23 @@ def replay_command(
     ais: Annotated[
         list[Path],
         typer.Argument(
-            help="AIS files: DMA CSV (22/26 columns), MarineCadastre CSV or raw NMEA (.gz ok)."
+            metavar="AIS...",
+            help="AIS files: DMA CSV (22/26 columns), MarineCadastre CSV or raw NMEA (.gz ok).",
         ),
     ],
     chart: Annotated[
         list[Path] | None,
-        typer.Option("--chart", help="Chart file (S-57 .000, GeoJSON, GeoPackage); repeatable."),
+        typer.Option(
+            "--chart",
+            metavar="CHART",
+            help="Chart file (S-57 .000, GeoJSON, GeoPackage); repeatable.",
+        ),
     ] = None,
     query: Annotated[
         Path | None,
         typer.Option(
             "--query",
+            metavar="FILE",
             help="Query TOML: region, time window, vessels and the [replay], [colregs] and "
             "[manoeuvrability] parameters. Without it: all the data, the paper's defaults.",
         ),
@@ -73,44 +79,56 @@ def replay_command(
     own_mmsi: Annotated[
         list[int] | None,
         typer.Option(
-            "--own-mmsi", help="Vessel in the own-ship seat; repeatable. Default: every vessel."
+            "--own-mmsi",
+            metavar="MMSI",
+            help="Vessel in the own-ship seat; repeatable. Default: every vessel.",
         ),
     ] = None,
     out: Annotated[
         Path | None,
-        typer.Option("--out", help="Output directory. Default: reports/replay-<query name>/."),
+        typer.Option(
+            "--out", metavar="DIR", help="Output directory. Default: reports/replay-<query name>/."
+        ),
     ] = None,
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Do not draw the per-encounter PNGs.")
     ] = False,
     fmt: Annotated[
         str | None,
-        typer.Option("--format", help="Input layout, when it cannot be detected from the file."),
+        typer.Option(
+            "--format",
+            metavar="LAYOUT",
+            help="Input layout, when it cannot be detected from the file.",
+        ),
     ] = None,
     step_s: Annotated[
-        float | None, typer.Option("--step-s", help="Replay time step Δt (s); 1.")
+        float | None, typer.Option("--step-s", metavar="S", help="Replay time step Δt (s); 1.")
     ] = None,
     tcpa_act_s: Annotated[
         float | None,
-        typer.Option("--tcpa-act-s", help="Trigger when 0 <= TCPA <= this (s); 180."),
+        typer.Option("--tcpa-act-s", metavar="S", help="Trigger when 0 <= TCPA <= this (s); 180."),
     ] = None,
     cpa_req_m: Annotated[
         float | None,
-        typer.Option("--cpa-req-m", help="Trigger when CPA is below this (m); 150."),
+        typer.Option("--cpa-req-m", metavar="M", help="Trigger when CPA is below this (m); 150."),
     ] = None,
     candidate_range_m: Annotated[
         float | None,
         typer.Option(
-            "--candidate-range-m", help="Pairs within this range are candidates (m); 3704 (2 nm)."
+            "--candidate-range-m",
+            metavar="M",
+            help="Pairs within this range are candidates (m); 3704 (2 nm).",
         ),
     ] = None,
     min_sog_kn: Annotated[
         float | None,
-        typer.Option("--min-sog-kn", help="Vessels slower than this form no pairs (kn); 0.5."),
+        typer.Option(
+            "--min-sog-kn", metavar="KN", help="Vessels slower than this form no pairs (kn); 0.5."
+        ),
     ] = None,
     alpha: Annotated[
         float | None,
-        typer.Option("--alpha", help="Scale α of the rate of swing, in [0, 1]; 0.4."),
+        typer.Option("--alpha", metavar="A", help="Scale α of the rate of swing, in [0, 1]; 0.4."),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
@@ -151,11 +169,18 @@ def replay_command(
 @app.command("simulate")
 def simulate_command(
     scenario: Annotated[
-        Path, typer.Argument(help="Scenario TOML (vessels, routes, speeds, timing, chart).")
+        Path,
+        typer.Argument(
+            metavar="SCENARIO.toml", help="Scenario TOML (vessels, routes, speeds, timing, chart)."
+        ),
     ],
     out: Annotated[
         Path | None,
-        typer.Option("--out", help="Output CSV. Default: reports/simulate-<scenario name>.csv."),
+        typer.Option(
+            "--out",
+            metavar="FILE.csv",
+            help="Output CSV. Default: reports/simulate-<scenario name>.csv.",
+        ),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
@@ -179,39 +204,46 @@ def stats_command(
     ais: Annotated[
         list[Path],
         typer.Argument(
+            metavar="AIS...",
             help="AIS files: DMA CSV (22/26 columns, .gz/.zip ok), MarineCadastre CSV, raw "
-            "NMEA or canonical Parquet."
+            "NMEA or canonical Parquet.",
         ),
     ],
     query: Annotated[
         Path | None,
         typer.Option(
-            "--query", help="Query TOML (region, time window, vessels). Default: all the data."
+            "--query",
+            metavar="FILE",
+            help="Query TOML (region, time window, vessels). Default: all the data.",
         ),
     ] = None,
     per: Annotated[
         str,
         typer.Option(
             "--per",
+            metavar="vessel|message",
             help="vessel: one value per vessel, the median of its reports; message: every "
             "position message in the query that has a value.",
         ),
     ] = "vessel",
     by: Annotated[
         str | None,
-        typer.Option("--by", help="ship_type: also one table per ship type."),
+        typer.Option("--by", metavar="ship_type", help="ship_type: also one table per ship type."),
     ] = None,
     fmt: Annotated[
         str | None,
         typer.Option(
             "--format",
+            metavar="LAYOUT",
             help="Input layout instead of detecting it: dma26, dma22, marinecadastre, nmea, "
             "parquet.",
         ),
     ] = None,
     out: Annotated[
         Path | None,
-        typer.Option("--out", help="Output directory. Default: reports/stats-<query name>/."),
+        typer.Option(
+            "--out", metavar="DIR", help="Output directory. Default: reports/stats-<query name>/."
+        ),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bar.")] = False,
 ) -> None:
@@ -236,7 +268,7 @@ def stats_command(
 def swing_command(
     out: Annotated[
         Path | None,
-        typer.Option("--out", help="Output directory. Default: reports/swing/."),
+        typer.Option("--out", metavar="DIR", help="Output directory. Default: reports/swing/."),
     ] = None,
 ) -> None:
     """The rate of swing of the paper's 14 reference vessels: table, CSV and figure.
@@ -258,20 +290,30 @@ def swing_command(
 def chart_command(
     charts: Annotated[
         list[Path],
-        typer.Argument(help="Chart files (S-57 .000, GeoJSON, GeoPackage); several are merged."),
+        typer.Argument(
+            metavar="CHART...",
+            help="Chart files (S-57 .000, GeoJSON, GeoPackage); several are merged.",
+        ),
     ],
     draught: Annotated[
         float | None,
         typer.Option(
-            "--draught", help="Draught (m): print the navigable area for it and draw the chart."
+            "--draught",
+            metavar="M",
+            help="Draught (m): print the navigable area for it and draw the chart.",
         ),
     ] = None,
     ukc: Annotated[
-        float, typer.Option("--ukc", help="Under-keel clearance added to the draught (m).")
+        float,
+        typer.Option("--ukc", metavar="M", help="Under-keel clearance added to the draught (m)."),
     ] = 0.0,
     out: Annotated[
         Path | None,
-        typer.Option("--out", help="Plot file (with --draught); reports/chart-<stem>.png."),
+        typer.Option(
+            "--out",
+            metavar="FILE.png",
+            help="Plot file (with --draught); reports/chart-<stem>.png.",
+        ),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
@@ -290,22 +332,23 @@ def chart_command(
 def demo_command(
     out: Annotated[
         Path | None,
-        typer.Option("--out", help="Output directory. Default: reports/demo/."),
+        typer.Option("--out", metavar="DIR", help="Output directory. Default: reports/demo/."),
     ] = None,
     scenarios: Annotated[
         Path,
         typer.Option(
             "--scenarios",
+            metavar="DIR",
             help="Directory with greenhopper_restricted.toml and greenhopper_not_restricted.toml.",
         ),
     ] = Path("fixtures/scenarios"),
     chart: Annotated[
         Path,
-        typer.Option("--chart", help="Chart for the replay."),
+        typer.Option("--chart", metavar="CHART", help="Chart for the replay."),
     ] = Path("fixtures/charts/aalborg_modelled.geojson"),
     query: Annotated[
         Path,
-        typer.Option("--query", help="Query TOML with the paper's parameters."),
+        typer.Option("--query", metavar="FILE", help="Query TOML with the paper's parameters."),
     ] = Path("queries/greenhopper.toml"),
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
