@@ -187,7 +187,8 @@ class Fields:
 
     ``mmsi`` is -1 where missing or not a number. ``unparseable`` marks rows with text
     where a number belongs (in MMSI, latitude or longitude), with ``problem`` saying what
-    for the ledger's examples. Positions and dimensions are cleaned (NaN = not available).
+    for the ledger's examples (empty when no row is unparseable). Positions and dimensions
+    are cleaned (NaN = not available).
     """
 
     mmsi: NDArray[np.int64]
@@ -210,6 +211,17 @@ def mmsi_column(values: pa.Array | pa.ChunkedArray) -> tuple[NDArray[np.int64], 
     whole = np.isfinite(floats) & (np.floor(floats) == floats)
     bad = bad | (np.isfinite(floats) & ~whole)
     return np.where(whole, floats, -1).astype(np.int64), bad
+
+
+def number_problems(
+    bad_mmsi: BoolArray, bad_lat: BoolArray, bad_lon: BoolArray
+) -> tuple[BoolArray, list[str]]:
+    """``Fields.unparseable`` and ``Fields.problem`` from where each column held text."""
+    unparseable = bad_mmsi | bad_lat | bad_lon
+    if not unparseable.any():
+        return unparseable, []
+    problem = np.where(bad_mmsi, "MMSI", np.where(bad_lat, "latitude", "longitude"))
+    return unparseable, problem.tolist()
 
 
 def nan_to_null(values: np.ndarray) -> pa.Array:

@@ -31,6 +31,7 @@ from .clean import (
     nan_to_null,
     nav_status_from_text,
     null_outside,
+    number_problems,
     positive_or_nan,
     whole_positive,
 )
@@ -95,18 +96,27 @@ def dma_fields(batch: pa.RecordBatch, has_abcd: bool) -> Fields:
     lat, bad_lat = float_column(batch.column("latitude"))
     lon, bad_lon = float_column(batch.column("longitude"))
     length, breadth, draught = _dimensions(batch, has_abcd)
-    problem = np.where(bad_mmsi, "MMSI", np.where(bad_lat, "latitude", "longitude"))
+    unparseable, problem = number_problems(bad_mmsi, bad_lat, bad_lon)
     return Fields(
         mmsi=mmsi,
         lat_deg=null_outside(lat, -90.0, 90.0),
         lon_deg=null_outside(lon, -180.0, 180.0),
-        vessel=is_vessel(pc.utf8_trim_whitespace(batch.column("type of mobile"))),
+        vessel=_is_vessel(batch.column("type of mobile")),
         length_m=length,
         breadth_m=breadth,
         draught_m=draught,
-        unparseable=bad_mmsi | bad_lat | bad_lon,
-        problem=problem.tolist(),
+        unparseable=unparseable,
+        problem=problem,
     )
+
+
+def _is_vessel(mobile_type: pa.Array) -> BoolArray:
+    # Trimming every row costs as much as the test itself; only the rows that fail need it.
+    vessel = is_vessel(mobile_type)
+    others = np.flatnonzero(~vessel)
+    if others.size:
+        vessel[others] = is_vessel(pc.utf8_trim_whitespace(mobile_type.take(others)))
+    return vessel
 
 
 def dma_static_text(batch: pa.RecordBatch) -> BoolArray:

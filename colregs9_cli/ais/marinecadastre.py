@@ -26,6 +26,7 @@ from .clean import (
     mmsi_column,
     nan_to_null,
     null_outside,
+    number_problems,
     positive_or_nan,
     whole_positive,
 )
@@ -89,7 +90,7 @@ def marinecadastre_fields(batch: pa.RecordBatch) -> Fields:
     mmsi, bad_mmsi = mmsi_column(batch.column("mmsi"))
     lat, bad_lat = float_column(batch.column("lat"))
     lon, bad_lon = float_column(batch.column("lon"))
-    problem = np.where(bad_mmsi, "MMSI", np.where(bad_lat, "latitude", "longitude"))
+    unparseable, problem = number_problems(bad_mmsi, bad_lat, bad_lon)
     return Fields(
         mmsi=mmsi,
         lat_deg=null_outside(lat, -90.0, 90.0),
@@ -98,8 +99,8 @@ def marinecadastre_fields(batch: pa.RecordBatch) -> Fields:
         length_m=positive_or_nan(float_column(batch.column("length"))[0]),
         breadth_m=positive_or_nan(float_column(batch.column("width"))[0]),
         draught_m=positive_or_nan(float_column(batch.column("draft"))[0]),
-        unparseable=bad_mmsi | bad_lat | bad_lon,
-        problem=problem.tolist(),
+        unparseable=unparseable,
+        problem=problem,
     )
 
 
