@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import NoDataError
 from .replay_params import ReplayParams
-from .tracks import Tracks
+from .tracks import STATE_COLUMNS, Tracks
 
 # Below this relative speed (m/s) the vessels keep their distance: TCPA 0, CPA = range.
 _STILL_MPS = 1e-6
@@ -363,21 +363,7 @@ def _encounter(run: object, own_mmsi: int, target_mmsi: int, tracks: Tracks) -> 
     )
 
 
-SERIES_VESSEL_COLUMNS: tuple[str, ...] = (
-    "north_m",
-    "east_m",
-    "lat_deg",
-    "lon_deg",
-    "cog_deg",
-    "heading_deg",
-    "course_deg",
-    "cog_grid_deg",
-    "heading_grid_deg",
-    "course_grid_deg",
-    "sog_kn",
-    "speed_mps",
-    "nav_status",
-)
+SERIES_VESSEL_COLUMNS: tuple[str, ...] = STATE_COLUMNS
 
 
 def encounter_series(

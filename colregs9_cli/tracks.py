@@ -69,12 +69,8 @@ STATIC_COLUMNS: tuple[str, ...] = (
     "breadth_m",
     "draught_m",
 )
-SAMPLE_COLUMNS: tuple[str, ...] = (
-    "mmsi",
-    "segment_id",
-    "step",
-    "t_s",
-    "timestamp",
+# A vessel's resampled state at a step (true courses for reports, grid courses for geometry).
+STATE_COLUMNS: tuple[str, ...] = (
     "north_m",
     "east_m",
     "lat_deg",
@@ -89,6 +85,7 @@ SAMPLE_COLUMNS: tuple[str, ...] = (
     "speed_mps",
     "nav_status",
 )
+SAMPLE_COLUMNS: tuple[str, ...] = ("mmsi", "segment_id", "step", "t_s", "timestamp", *STATE_COLUMNS)
 
 
 @dataclass(frozen=True)

@@ -28,17 +28,14 @@ from colregs9_cli.encounters import find_encounters
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.replay import run_replay
 from colregs9_cli.replay_params import ReplayParams
+from colregs9_cli.simulate import DMA_COLUMNS
 from colregs9_cli.tracks import build_tracks
 from colregs9_cli.units import MPS_PER_KNOT
 
 ROOT = Path(__file__).resolve().parents[2]
 NATIONAL_SAMPLE = ROOT / "fixtures" / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
 HARBOUR_CENTRE = (57.05, 9.94)
-DMA_HEADER = (
-    "# Timestamp,Type of mobile,MMSI,Latitude,Longitude,Navigational status,ROT,SOG,COG,"
-    "Heading,IMO,Callsign,Name,Ship type,Cargo type,Width,Length,"
-    "Type of position fixing device,Draught,Destination,ETA,Data source type,A,B,C,D"
-)
+DMA_HEADER = ",".join(DMA_COLUMNS)
 
 
 def harbour_positions(

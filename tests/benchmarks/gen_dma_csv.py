@@ -23,34 +23,9 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 
-HEADER = [
-    "# Timestamp",
-    "Type of mobile",
-    "MMSI",
-    "Latitude",
-    "Longitude",
-    "Navigational status",
-    "ROT",
-    "SOG",
-    "COG",
-    "Heading",
-    "IMO",
-    "Callsign",
-    "Name",
-    "Ship type",
-    "Cargo type",
-    "Width",
-    "Length",
-    "Type of position fixing device",
-    "Draught",
-    "Destination",
-    "ETA",
-    "Data source type",
-    "A",
-    "B",
-    "C",
-    "D",
-]
+from colregs9_cli.simulate import DMA_COLUMNS
+
+HEADER = list(DMA_COLUMNS)
 
 LIMFJORD_BOX = (56.5, 57.2, 8.2, 10.4)  # lat_min, lat_max, lon_min, lon_max
 DANISH_WATERS = (54.5, 58.0, 7.5, 13.0)
