@@ -368,16 +368,29 @@ def _read_features(path: Path) -> _Features:
     return features
 
 
-def chart_bounds_wgs84(paths: Sequence[Path]) -> tuple[float, float, float, float]:
-    """(lat_min, lat_max, lon_min, lon_max) of the charts' features."""
-    return _bounds([_read_features(Path(p)) for p in paths])
+@dataclass(frozen=True)
+class ChartSource:
+    """Charts read from their files in WGS84, not yet projected: read once, project once."""
+
+    paths: tuple[Path, ...]
+    features: tuple[_Features, ...]
+
+    def bounds_wgs84(self) -> tuple[float, float, float, float]:
+        """(lat_min, lat_max, lon_min, lon_max) of the charts' features."""
+        lon_min, lat_min, lon_max, lat_max = shapely.total_bounds(
+            np.concatenate([f.geometries for f in self.features])
+        )
+        return float(lat_min), float(lat_max), float(lon_min), float(lon_max)
 
 
-def _bounds(features: Sequence[_Features]) -> tuple[float, float, float, float]:
-    lon_min, lat_min, lon_max, lat_max = shapely.total_bounds(
-        np.concatenate([f.geometries for f in features])
+def read_charts(paths: Sequence[Path]) -> ChartSource:
+    """Read every chart file (S-57, GeoJSON, GeoPackage); errors name the file."""
+    if not paths:
+        raise ChartError("no chart given; give at least one chart file")
+    return ChartSource(
+        paths=tuple(Path(p) for p in paths),
+        features=tuple(_read_features(Path(p)) for p in paths),
     )
-    return float(lat_min), float(lat_max), float(lon_min), float(lon_max)
 
 
 def _project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
@@ -394,11 +407,14 @@ def _project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
 
 def load_chart(paths: Sequence[Path], frame: LocalFrame | None = None) -> Chart:
     """Read and merge charts, project them into ``frame`` (default: centred on their extent)."""
-    if not paths:
-        raise ChartError("no chart given; give at least one chart file")
-    features = [_read_features(Path(p)) for p in paths]
+    return project_charts(read_charts(paths), frame)
+
+
+def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Chart:
+    """Merge charts already read and project them into ``frame`` (default: their extent)."""
+    features = source.features
     if frame is None:
-        frame = LocalFrame.centred_on(*_bounds(features))
+        frame = LocalFrame.centred_on(*source.bounds_wgs84())
     geometries = _project(np.concatenate([f.geometries for f in features]), frame)
     object_class = np.concatenate([f.object_class for f in features])
     drval1 = np.concatenate([f.drval1_m for f in features])
@@ -429,7 +445,7 @@ def load_chart(paths: Sequence[Path], frame: LocalFrame | None = None) -> Chart:
         land=land,
         hazards=shapely.union_all(hazard_areas),
         coverage=coverage,
-        sources=tuple(Path(p) for p in paths),
+        sources=source.paths,
         layer_counts={name: counts[name] for name in _OBJECT_CLASSES if name in counts},
         hazard_areas=hazard_areas,
         hazard_depth_m=hazard_depth,

@@ -41,7 +41,7 @@ import pandas as pd
 
 from .ais.ledger import RejectReason, RejectsLedger
 from .ais.load import AisData, load_ais
-from .chart import Chart, chart_bounds_wgs84, load_chart
+from .chart import Chart, project_charts, read_charts
 from .colregs import (
     ColregsParams,
     Kinematics,
@@ -560,13 +560,14 @@ def load_run_chart(
 
     The boxes are compared first, so that a chart far away is never projected into the frame.
     """
-    lat_min, lat_max, lon_min, lon_max = chart_bounds_wgs84(chart_paths)
+    source = read_charts(chart_paths)
+    lat_min, lat_max, lon_min, lon_max = source.bounds_wgs84()
     lat = positions["lat_deg"].to_numpy(dtype=float)
     lon = positions["lon_deg"].to_numpy(dtype=float)
     in_box = (lat >= lat_min) & (lat <= lat_max) & (lon >= lon_min) & (lon <= lon_max)
     if not in_box.any():
         raise _no_overlap(chart_paths, positions)
-    chart = load_chart(list(chart_paths), frame)
+    chart = project_charts(source, frame)
     north_m, east_m = frame.to_local(lat[in_box], lon[in_box])
     if not chart.covers(north_m, east_m).any():
         raise _no_overlap(chart_paths, positions)

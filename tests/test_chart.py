@@ -17,7 +17,7 @@ import pytest
 import shapely
 from pyogrio.raw import read, write
 
-from colregs9_cli.chart import HAZARD_RADIUS_M, Chart, chart_bounds_wgs84, load_chart
+from colregs9_cli.chart import HAZARD_RADIUS_M, Chart, load_chart, read_charts
 from colregs9_cli.errors import ChartError, ParameterError
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.manoeuvrability import ManoeuvrabilityParams, assess_manoeuvrability
@@ -56,7 +56,7 @@ def test_enc_depth_range(enc: Chart) -> None:
 
 
 def test_enc_extent_and_coverage(enc: Chart) -> None:
-    assert chart_bounds_wgs84([ENC]) == pytest.approx((38.925, 39.0, -76.5, -76.425))
+    assert read_charts([ENC]).bounds_wgs84() == pytest.approx((38.925, 39.0, -76.5, -76.425))
     assert enc.bounds_wgs84() == pytest.approx((38.925, 39.0, -76.5, -76.425), abs=1e-6)
     # The cell's own coverage record M_COVR, projected the same way, has the same area: depth
     # areas, land and structures tile the cell.
