@@ -15,8 +15,9 @@ from hypothesis import strategies as st
 from pyais import encode_dict
 
 from colregs9_cli.ais.batch import AisBatch
+from colregs9_cli.ais.clean import SHIP_TYPE_CATEGORIES
 from colregs9_cli.ais.ledger import RejectReason, RejectsLedger
-from colregs9_cli.ais.nmea import SHIP_TYPE_CATEGORIES, read_nmea
+from colregs9_cli.ais.nmea import read_nmea
 from colregs9_cli.errors import InputFileError
 
 NOON = 1_384_257_600  # 2013-11-12 12:00:00 UTC

@@ -77,8 +77,16 @@ NUMERIC_COLUMNS = (
 STATIC_TEXT_COLUMNS = ("ship type", "name", "callsign", "imo")
 
 
+# Columns ``dma_fields`` reads: converted for every row, the others only for the rows kept.
+ROW_COLUMNS = ("type of mobile", "mmsi", "latitude", "longitude", "width", "length", "draught")
+
+
 def read_columns(has_abcd: bool) -> tuple[str, ...]:
     return (*READ_COLUMNS, *ABCD) if has_abcd else READ_COLUMNS
+
+
+def row_columns(has_abcd: bool) -> tuple[str, ...]:
+    return (*ROW_COLUMNS, *ABCD) if has_abcd else ROW_COLUMNS
 
 
 def _dimensions(batch: pa.RecordBatch, has_abcd: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

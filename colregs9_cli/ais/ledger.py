@@ -53,6 +53,10 @@ class RejectsLedger:
             if len(bucket) < self.max_examples:
                 bucket.append(example)
 
+    def wants_example(self, reason: RejectReason) -> bool:
+        """Whether an example of ``reason`` would still be kept (to skip building it)."""
+        return len(self.examples.get(reason.value, ())) < self.max_examples
+
     @property
     def rejected_total(self) -> int:
         return sum(self.rejects.values())

@@ -29,16 +29,19 @@ the query, position rows and static reports alike, minus rows rejected in steps 
 It is restricted to the vessels that have a position in the query. Rows outside the region
 are not checked for a bad timestamp or duplicates, so they count as reports as they are.
 
-Memory: CSV is read in blocks of ``BLOCK_BYTES`` with pyarrow; a block is dropped once its
-rows in the query are kept, so memory grows with the kept rows, not with the file. A CSV
-whose numeric columns hold text somewhere is read a second time with every column as text
-(the fast first pass reads numbers directly). pyarrow parses on several threads, which
-loses the line numbers of malformed rows: a CSV with a malformed row is read again on one
-thread, so its examples name the exact line. NMEA is decoded whole per file (see nmea.py).
+Memory: CSV is read in chunks of whole lines (``csv_chunks.CHUNK_BYTES``); a chunk is
+dropped once its rows in the query are kept, so memory grows with the kept rows, not with
+the file. Only the columns every row needs are converted for every row; the rest only for
+the rows kept and the static reports (see csv_chunks.py). A CSV whose numeric columns hold
+text in a converted row is read a second time with every column as text (the fast first
+pass reads numbers directly). pyarrow parses on several threads, which loses the line
+numbers of malformed rows: a CSV with a malformed row is read again on one thread, so its
+examples name the exact line. NMEA is decoded whole per file (see nmea.py).
 """
 
 from __future__ import annotations
 
+import contextlib
 import io
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -49,7 +52,6 @@ import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
-import pyarrow.csv as pacsv
 import pyarrow.parquet as pq
 
 from ..errors import InputFileError, NoDataError, ParameterError
@@ -58,11 +60,11 @@ from ..query import Query, everything_query
 from . import dma, marinecadastre
 from .batch import AisBatch
 from .clean import Fields, clean_text, is_vessel, null_outside, valid_mmsi
+from .csv_chunks import CsvChunk, MalformedRowsFound, NotUtf8, read_chunks
 from .detect import CSV_LAYOUTS, LAYOUTS, csv_header, detect_layout
 from .ledger import RejectReason, RejectsLedger
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from .sources import (
-    ReadaheadLimit,
     Source,
     decompression_error,
     inspect_source,
@@ -74,9 +76,6 @@ from .sources import (
 
 __all__ = ["LAYOUTS", "AisData", "InputFile", "load_ais"]
 
-BLOCK_BYTES = 8 * 1024 * 1024
-# Blocks the CSV reader may read ahead of the pipeline (memory: about this many blocks).
-READAHEAD_BLOCKS = 4
 PARQUET_BATCH_ROWS = 256 * 1024
 DIMENSIONS = ("length_m", "breadth_m", "draught_m")
 DIMENSION_REPORT_COLUMNS = ("mmsi", *DIMENSIONS, "n_reports")
@@ -255,6 +254,7 @@ _NO_PROGRESS = _NoProgress()
 @dataclass(frozen=True)
 class _CsvLayout:
     columns: tuple[str, ...]
+    row_columns: tuple[str, ...]  # what ``fields`` reads: converted for every row
     numeric: tuple[str, ...]
     fields: Callable[[pa.RecordBatch], Fields]
     static_text: Callable[[pa.RecordBatch], np.ndarray]
@@ -267,6 +267,7 @@ def _csv_layout(layout: str) -> _CsvLayout:
         abcd = layout == "dma26"
         return _CsvLayout(
             columns=dma.read_columns(abcd),
+            row_columns=dma.row_columns(abcd),
             numeric=tuple(c for c in dma.NUMERIC_COLUMNS if abcd or c not in dma.ABCD),
             fields=lambda b: dma.dma_fields(b, abcd),
             static_text=dma.dma_static_text,
@@ -281,6 +282,7 @@ def _csv_layout(layout: str) -> _CsvLayout:
         )
     return _CsvLayout(
         columns=marinecadastre.READ_COLUMNS,
+        row_columns=marinecadastre.ROW_COLUMNS,
         numeric=marinecadastre.NUMERIC_COLUMNS,
         fields=marinecadastre.marinecadastre_fields,
         static_text=marinecadastre.marinecadastre_static_text,
@@ -293,23 +295,6 @@ def _csv_layout(layout: str) -> _CsvLayout:
             "time": "basedatetime",
         },
     )
-
-
-class _LineNumbers:
-    """Line numbers of CSV data rows, given the lines the reader skipped as invalid."""
-
-    def __init__(self, first_data_line: int) -> None:
-        self.first_data_line = first_data_line
-        self.invalid_lines: list[int] = []
-
-    def line_of(self, row: int) -> int:
-        """The file line of the ``row``-th (0-based) valid data row."""
-        line = self.first_data_line + row
-        for invalid in self.invalid_lines:
-            if invalid > line:
-                break
-            line += 1
-        return line
 
 
 def _read_csv(
@@ -334,102 +319,76 @@ def _read_csv(
             f"header does not have; check the file or the --format given"
         )
     result = _FileResult(query, source.name, layout=layout)
-    lines = _LineNumbers(2 if header.has_header else 1)
 
-    malformed_seen = False
+    def types(columns: Sequence[str]) -> dict[str, pa.DataType]:
+        return {c: pa.float64() if fast and c in spec.numeric else pa.string() for c in columns}
 
-    def invalid_row(row: Any) -> str:
-        nonlocal malformed_seen
-        if threads:
-            malformed_seen = True
-            return "error"  # stops the read; an exception here would be ignored by pyarrow
-        result.ledger.read()
-        if row.number is not None:
-            lines.invalid_lines.append(row.number)
-        result.ledger.reject(
-            RejectReason.UNPARSEABLE,
-            example=f"{source.name}:{row.number}: expected {row.expected_columns} fields, found "
-            f"{row.actual_columns}: {row.text[:_EXAMPLE_CHARS]}",
-        )
-        return "skip"
-
-    column_types = {
-        c: (pa.float64() if fast and c in spec.numeric else pa.string()) for c in spec.columns
-    }
-    read_options = pacsv.ReadOptions(
-        column_names=list(header.columns),
-        skip_rows=1 if header.has_header else 0,
-        block_size=BLOCK_BYTES,
-        use_threads=threads,
-    )
-    parse_options = pacsv.ParseOptions(invalid_row_handler=invalid_row)
-    convert_options = pacsv.ConvertOptions(
-        column_types=column_types,
-        include_columns=list(spec.columns),
-        strings_can_be_null=False,
-        quoted_strings_can_be_null=False,
-    )
-    rows_before = 0
     with open_data(source, bar) as opened:
-        limited = ReadaheadLimit(opened.stream, READAHEAD_BLOCKS)
+        chunks = read_chunks(
+            opened.stream,
+            header.columns,
+            header.has_header,
+            row_types=types(spec.row_columns),
+            all_types=types(spec.columns),
+            threads=threads,
+        )
         try:
-            reader = pacsv.open_csv(
-                limited,
-                read_options=read_options,
-                parse_options=parse_options,
-                convert_options=convert_options,
-            )
-            for batch in reader:
-                limited.consumed()
-                _csv_block(result, spec, batch, rows_before, lines)
-                rows_before += batch.num_rows
+            with contextlib.closing(chunks):
+                for chunk in chunks:
+                    _csv_chunk(result, spec, chunk)
+        except MalformedRowsFound:
+            raise _NeedsLineNumbers from None
+        except NotUtf8:
+            raise _non_utf8_error(source) from None
         except pa.ArrowInvalid as exc:
-            if malformed_seen:
-                raise _NeedsLineNumbers from None
             raise _csv_error(source, exc, fast) from None
-        finally:
-            limited.release()
         result.sha256 = opened.finish()
     return result
 
 
+def _non_utf8_error(source: Source) -> InputFileError:
+    located = locate_non_utf8(source)
+    if located is None:
+        return InputFileError(f"{source.name}: the file is not UTF-8; convert it to UTF-8")
+    line, offset, byte = located
+    return InputFileError(
+        f"{source.name}:{line}: byte 0x{byte:02x} at offset {offset} is not UTF-8; "
+        "convert the file to UTF-8 (e.g. iconv -f latin1 -t utf-8)"
+    )
+
+
 def _csv_error(source: Source, exc: pa.ArrowInvalid, fast: bool) -> Exception:
     message = str(exc)
-    if "UTF8" in message or "UTF-8" in message:
-        located = locate_non_utf8(source)
-        if located is not None:
-            line, offset, byte = located
-            return InputFileError(
-                f"{source.name}:{line}: byte 0x{byte:02x} at offset {offset} is not UTF-8; "
-                "convert the file to UTF-8 (e.g. iconv -f latin1 -t utf-8)"
-            )
     if fast and "conversion error" in message:
         return _NeedsTextColumns()
-    if "Empty CSV" in message:
-        return InputFileError(f"{source.name}: no CSV data; give a file with AIS rows")
     return InputFileError(f"{source.name}: cannot read the CSV ({message}); check the file")
 
 
-def _csv_block(
-    result: _FileResult,
-    spec: _CsvLayout,
-    batch: pa.RecordBatch,
-    rows_before: int,
-    lines: _LineNumbers,
-) -> None:
-    n = batch.num_rows
-    result.ledger.read(n)
+def _csv_chunk(result: _FileResult, spec: _CsvLayout, chunk: CsvChunk) -> None:
+    for bad in chunk.invalid_rows:
+        result.ledger.read()
+        result.ledger.reject(
+            RejectReason.UNPARSEABLE,
+            example=f"{result.name}:{bad.line}: expected {bad.expected_columns} fields, found "
+            f"{bad.actual_columns}: {bad.text[:_EXAMPLE_CHARS]}",
+        )
+    rows = chunk.rows
+    result.ledger.read(rows.num_rows)
 
     def example(row: int, what: str, why: str) -> str:
-        value = batch.column(spec.example_columns[what])[row].as_py()
+        column = spec.example_columns[what]
+        if column in rows.column_names:
+            value = rows.column(column)[row].as_py()
+        else:
+            value = chunk.take(np.array([row])).column(column)[0].as_py()
         if isinstance(value, float) and value.is_integer():
             value = int(value)
-        return f"{result.name}:{lines.line_of(rows_before + row)}: {why} {value!r}"
+        return f"{result.name}:{chunk.line_of(row)}: {why} {value!r}"
 
     _classify(
         result,
-        spec.fields(batch),
-        batch,
+        spec.fields(rows),
+        chunk.take,
         static_text=spec.static_text,
         canonical=spec.canonical,
         example=example,
@@ -442,12 +401,15 @@ Example = Callable[[int, str, str], str]
 def _classify(
     result: _FileResult,
     fields: Fields,
-    batch: pa.RecordBatch | pa.Table,
+    take: Callable[[np.ndarray], pa.Table],
     static_text: Callable[[Any], np.ndarray] | None,
     canonical: Callable[[Any], tuple[pa.Table, np.ndarray]],
     example: Example,
 ) -> None:
-    """Account every row of one block (see the module docstring) and keep the query's rows."""
+    """Account every row of one block (see the module docstring) and keep the query's rows.
+
+    ``take(rows)`` gives every column of those rows of the block.
+    """
     ledger = result.ledger
     query = result.query
     left = np.ones(len(fields), dtype=bool)
@@ -455,7 +417,9 @@ def _classify(
     def reject(mask: np.ndarray, reason: RejectReason, what: str, why: str) -> None:
         rows = np.flatnonzero(mask)
         if rows.size:
-            ledger.reject(reason, int(rows.size), example=example(int(rows[0]), what, why))
+            wanted = ledger.wants_example(reason)
+            sample = example(int(rows[0]), what, why) if wanted else None
+            ledger.reject(reason, int(rows.size), example=sample)
 
     unparseable = fields.unparseable
     if unparseable.any():
@@ -477,7 +441,7 @@ def _classify(
     static_report = no_position & has_dimension
     if static_text is not None and no_position.any():
         rows = np.flatnonzero(no_position)
-        static_report[rows] |= static_text(batch.take(pa.array(rows)))
+        static_report[rows] |= static_text(take(rows))
     elif static_text is None:
         static_report[:] = False
     ledger.use(int(static_report.sum()))
@@ -498,7 +462,7 @@ def _classify(
         left[rows[~inside]] = False
     rows = np.flatnonzero(left)
     if rows.size:
-        table, bad_time = canonical(batch.take(pa.array(rows)))
+        table, bad_time = canonical(take(rows))
         if bad_time.any():
             first = int(rows[np.flatnonzero(bad_time)[0]])
             ledger.reject(
@@ -557,6 +521,10 @@ def _canonical_fields(table: pa.Table) -> Fields:
     )
 
 
+def _taker(table: pa.Table) -> Callable[[np.ndarray], pa.Table]:
+    return lambda rows: table.take(pa.array(rows))
+
+
 def _canonical_identity(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
     bad_time = table.column("timestamp").is_null().to_numpy(zero_copy_only=False)
     return table, np.asarray(bad_time, dtype=bool)
@@ -607,7 +575,7 @@ def _nmea_batch(result: _FileResult, batch: AisBatch) -> None:
     _classify(
         result,
         _canonical_fields(positions),
-        positions,
+        _taker(positions),
         static_text=None,
         canonical=_canonical_identity,
         example=_table_example(result.name, positions),
@@ -674,7 +642,7 @@ def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResul
             _classify(
                 result,
                 _canonical_fields(table),
-                table,
+                _taker(table),
                 static_text=_canonical_static_text,
                 canonical=_canonical_identity,
                 example=example,

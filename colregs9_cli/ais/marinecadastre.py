@@ -16,6 +16,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from .clean import (
+    SHIP_TYPE_CATEGORIES,
     BoolArray,
     Fields,
     clean_angle,
@@ -30,7 +31,6 @@ from .clean import (
     positive_or_nan,
     whole_positive,
 )
-from .nmea import SHIP_TYPE_CATEGORIES
 from .schema import CANONICAL_SCHEMA
 
 READ_COLUMNS = (
@@ -51,6 +51,8 @@ READ_COLUMNS = (
     "draft",
     "transceiverclass",
 )
+# Columns ``marinecadastre_fields`` reads: converted for every row.
+ROW_COLUMNS = ("mmsi", "lat", "lon", "transceiverclass", "length", "width", "draft")
 NUMERIC_COLUMNS = (
     "mmsi",
     "lat",

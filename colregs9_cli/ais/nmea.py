@@ -75,40 +75,9 @@ from pyais.messages import (
 )
 
 from .batch import STATIC_SCHEMA, AisBatch
+from .clean import SHIP_TYPE_CATEGORIES
 from .ledger import RejectReason, RejectsLedger
 from .schema import CANONICAL_SCHEMA
-
-# Numeric AIS ship type (ITU-R M.1371 table 53) -> the DMA "Ship type" text. 0 ("not
-# available") is absent on purpose: it becomes null, like DMA's "Undefined".
-SHIP_TYPE_CATEGORIES: dict[int, str] = {
-    **dict.fromkeys(range(1, 20), "Reserved"),
-    **dict.fromkeys(range(20, 30), "WIG"),
-    30: "Fishing",
-    31: "Towing",
-    32: "Towing long/wide",
-    33: "Dredging",
-    34: "Diving",
-    35: "Military",
-    36: "Sailing",
-    37: "Pleasure",
-    38: "Reserved",
-    39: "Reserved",
-    **dict.fromkeys(range(40, 50), "HSC"),
-    50: "Pilot",
-    51: "SAR",
-    52: "Tug",
-    53: "Port tender",
-    54: "Anti-pollution",
-    55: "Law enforcement",
-    56: "Spare 1",
-    57: "Spare 2",
-    58: "Medical",
-    59: "Not party to conflict",
-    **dict.fromkeys(range(60, 70), "Passenger"),
-    **dict.fromkeys(range(70, 80), "Cargo"),
-    **dict.fromkeys(range(80, 90), "Tanker"),
-    **dict.fromkeys(range(90, 100), "Other"),
-}
 
 POSITION_TYPES = frozenset({1, 2, 3, 18, 19, 27})
 STATIC_TYPES = frozenset({5, 24})

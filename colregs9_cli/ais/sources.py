@@ -12,7 +12,6 @@ from __future__ import annotations
 import gzip
 import hashlib
 import io
-import threading
 import zipfile
 import zlib
 from collections.abc import Iterator
@@ -202,49 +201,3 @@ def locate_non_utf8(source: Source) -> tuple[int, int, int] | None:
                 return line_no, offset + exc.start, line[exc.start]
             offset += len(line)
     return None
-
-
-class ReadaheadLimit:
-    """Keeps a background reader at most ``blocks`` reads ahead of the consumer.
-
-    pyarrow's streaming CSV reader reads its input ahead without bound on a background
-    thread: on a file that parses slower than it reads, the whole file ends up in memory.
-    Wrapped in this, a read made off the consumer's thread waits until the consumer has
-    taken enough batches (``consumed``), so memory stays at a few blocks. Reads on the
-    consumer's own thread never wait (that would deadlock).
-    """
-
-    def __init__(self, stream: BinaryIO, blocks: int) -> None:
-        self._stream = stream
-        self._blocks = blocks
-        self._reads = 0
-        self._consumed = 0
-        self._consumer = threading.get_ident()
-        self._changed = threading.Condition()
-        self.closed = False
-
-    def readable(self) -> bool:
-        return True
-
-    def read(self, size: int = -1) -> bytes:
-        if threading.get_ident() != self._consumer:
-            with self._changed:
-                self._changed.wait_for(lambda: self._reads - self._consumed < self._blocks)
-        data = self._stream.read(size)
-        with self._changed:
-            self._reads += 1
-        return data
-
-    def consumed(self) -> None:
-        with self._changed:
-            self._consumed += 1
-            self._changed.notify_all()
-
-    def release(self) -> None:
-        """Let a waiting reader go (the consumer stopped early)."""
-        with self._changed:
-            self._consumed = 1 << 60
-            self._changed.notify_all()
-
-    def close(self) -> None:
-        self.closed = True

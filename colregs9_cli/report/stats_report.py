@@ -10,11 +10,6 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
@@ -126,7 +121,9 @@ def format_markdown(result: StatsResult, query_name: str) -> str:
 
 def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     """Three histograms (length, breadth, draught) of the counted units' values."""
-    figure, axes = plt.subplots(1, 3, figsize=(13, 4), layout="constrained")
+    # A bare Figure renders with Agg on save, without pyplot's backend machinery.
+    figure = Figure(figsize=(13, 4), layout="constrained")
+    axes = figure.subplots(1, 3)
     for axis, (dimension, label) in zip(axes, DIMENSION_LABELS.items(), strict=True):
         values = result.samples[dimension].dropna().to_numpy(dtype=float)
         if values.size:
@@ -170,10 +167,6 @@ def write_stats_reports(
     manifest_path = out_dir / MANIFEST_NAME
     write_csv(csv_path, result.to_frame())
     write_text(markdown_path, format_markdown(result, query_name))
-    figure = histogram_figure(result, query_name)
-    try:
-        save_figure(histogram_path, figure, dpi=110)
-    finally:
-        plt.close(figure)
+    save_figure(histogram_path, histogram_figure(result, query_name), dpi=110)
     write_json(manifest_path, manifest)
     return (csv_path, markdown_path, histogram_path, manifest_path)

@@ -1,0 +1,290 @@
+"""Reading a CSV in chunks of whole lines: every row's filter columns, the rest on demand.
+
+A DMA day file is mostly rows outside the query. Converting all of their columns is what
+makes a plain streaming read slow, so each chunk (``CHUNK_BYTES`` of whole lines) is parsed
+by pyarrow's ``read_csv`` on all cores with only the columns that every row needs
+(``row_types``: position, MMSI, mobile type, dimensions). The few rows that the pipeline
+keeps are then cut out of the chunk's bytes by their line offsets and parsed again with all
+columns (``CsvChunk.take``). The next chunk is read and parsed on a worker thread while the
+caller works on the current one, so memory stays at about two chunks.
+
+A row is one line: pyarrow's default (``newlines_in_values=False``) ends a row at every
+line end (LF, CRLF or a lone CR), quoted or not, and skips empty lines. Should a chunk's
+non-empty lines not match its rows one to one, the chunk is parsed whole with all columns
+instead, which is slower but gives the same rows (line numbers are then the chunk's first).
+
+Malformed rows (a wrong number of fields) are reported with their file line when
+``threads`` is false. Parsing on several threads loses line numbers, so there the first
+malformed row stops the read with ``MalformedRowsFound``, for the caller to read again on
+one thread.
+"""
+
+from __future__ import annotations
+
+import codecs
+import functools
+from collections.abc import Generator, Mapping, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Any, BinaryIO
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.csv as pacsv
+from numpy.typing import NDArray
+
+CHUNK_BYTES = 16 * 1024 * 1024
+# pyarrow's parallel unit inside a chunk.
+PARSE_BLOCK_BYTES = 4 * 1024 * 1024
+_NEWLINE, _CARRIAGE_RETURN, _FIRST_NON_ASCII = 10, 13, 128
+
+
+class MalformedRowsFound(Exception):
+    """A row with a wrong number of fields, met while parsing on several threads."""
+
+
+class NotUtf8(Exception):
+    """A chunk holds bytes that are not UTF-8."""
+
+
+@dataclass(frozen=True)
+class InvalidRow:
+    line: int
+    expected_columns: int
+    actual_columns: int
+    text: str
+
+
+class CsvChunk:
+    """One chunk: ``rows`` holds the row columns of its valid rows, in file order."""
+
+    def __init__(
+        self,
+        rows: pa.Table,
+        invalid_rows: list[InvalidRow],
+        data: memoryview,
+        newline_offsets: NDArray[np.int64],
+        first_line: int,
+        malformed: NDArray[np.int64],
+        names: Sequence[str],
+        all_types: Mapping[str, pa.DataType],
+    ) -> None:
+        self.rows = rows
+        self.invalid_rows = invalid_rows
+        self._data = data
+        self._newline_offsets = newline_offsets
+        self._first_line = first_line
+        self._malformed = malformed  # their indices among the non-empty lines
+        self._names = names
+        self._all_types = all_types
+
+    @functools.cached_property
+    def _row_lines(self) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]] | None:
+        """Each row's line index in the chunk and the (start, newline) offsets of that line;
+        None if rows and lines do not match one to one."""
+        starts, ends, non_empty = _lines(self._data, self._newline_offsets)
+        row_line = np.delete(non_empty, self._malformed)
+        if len(row_line) != self.rows.num_rows:
+            return None
+        return row_line, starts[row_line], ends[row_line]
+
+    def line_of(self, row: int) -> int:
+        """The file line (1-based) of a row; the chunk's first line if rows and lines differ."""
+        if self._row_lines is None:
+            return self._first_line
+        return self._first_line + int(self._row_lines[0][row])
+
+    def take(self, rows: NDArray[np.int64]) -> pa.Table:
+        """All columns of the given rows (indices into ``rows``), in that order."""
+        if self._row_lines is None:
+            whole = _parse(self._data, self._names, self._all_types, threads=False)
+            return whole.take(pa.array(rows, pa.int64()))
+        _, starts, ends = self._row_lines
+        data = self._data
+        lines = b"".join(
+            data[start : end + 1]
+            for start, end in zip(starts[rows].tolist(), ends[rows].tolist(), strict=True)
+        )
+        return _parse(memoryview(lines), self._names, self._all_types, threads=False)
+
+
+def read_chunks(
+    stream: BinaryIO,
+    names: Sequence[str],
+    has_header: bool,
+    row_types: Mapping[str, pa.DataType],
+    all_types: Mapping[str, pa.DataType],
+    threads: bool,
+) -> Generator[CsvChunk, None, None]:
+    """The chunks of a CSV stream, each parsed (on a worker thread) while the last is used.
+
+    Raises ``pa.ArrowInvalid`` for data pyarrow cannot read, ``MalformedRowsFound`` (threads
+    only), ``NotUtf8``, and whatever reading the stream raises.
+    """
+    pieces = _Pieces(stream, first_line=2 if has_header else 1, skip_header=has_header)
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="colregs9-csv") as pool:
+
+        def submit() -> Future[CsvChunk | None]:
+            return pool.submit(_next_chunk, pieces, names, row_types, all_types, threads)
+
+        pending = submit()
+        try:
+            while (chunk := pending.result()) is not None:
+                pending = submit()
+                yield chunk
+        finally:
+            pending.cancel()
+
+
+class _Pieces:
+    """Whole-line pieces of a stream, each in its own buffer, and the file line the next
+    one starts on. Used by the worker thread only."""
+
+    def __init__(self, stream: BinaryIO, first_line: int, skip_header: bool) -> None:
+        self._stream = stream
+        self._carry = b""
+        self._skip_header = skip_header
+        self.next_line = first_line
+
+    def read(self) -> tuple[memoryview, bool] | None:
+        """The next piece, and whether it holds a carriage return."""
+        while True:
+            carried = len(self._carry)
+            buffer = bytearray(carried + CHUNK_BYTES)
+            buffer[:carried] = self._carry
+            got = self._stream.readinto(memoryview(buffer)[carried:])  # type: ignore[attr-defined]
+            end = carried + got
+            if got:
+                cut = _last_line_end(buffer, end)
+                if cut == 0:
+                    self._carry = bytes(buffer[:end])
+                    continue
+                self._carry = bytes(buffer[cut:end])
+            else:
+                self._carry = b""
+                if end and buffer[end - 1] not in (_NEWLINE, _CARRIAGE_RETURN):
+                    buffer[end] = _NEWLINE
+                    end += 1
+                cut = end
+            start = 0
+            if self._skip_header and cut:
+                self._skip_header = False
+                start = _first_line_end(buffer, cut)
+            if start < cut:
+                return memoryview(buffer)[start:cut], buffer.find(b"\r", start, cut) != -1
+            if not got:
+                return None
+
+
+def _last_line_end(buffer: bytearray, end: int) -> int:
+    """Just past the last line end before ``end`` (0 if none): a newline, else a lone CR."""
+    cut = buffer.rfind(b"\n", 0, end) + 1
+    return cut if cut else buffer.rfind(b"\r", 0, end) + 1
+
+
+def _first_line_end(buffer: bytearray, end: int) -> int:
+    """Just past the first line (the header), which may end in LF, CRLF or a lone CR."""
+    newline, carriage = buffer.find(b"\n", 0, end), buffer.find(b"\r", 0, end)
+    if carriage != -1 and (newline == -1 or carriage + 1 < newline):
+        return carriage + 1
+    return newline + 1 if newline != -1 else end
+
+
+def _next_chunk(
+    pieces: _Pieces,
+    names: Sequence[str],
+    row_types: Mapping[str, pa.DataType],
+    all_types: Mapping[str, pa.DataType],
+    threads: bool,
+) -> CsvChunk | None:
+    piece = pieces.read()
+    if piece is None:
+        return None
+    data, has_carriage_return = piece
+    raw = np.frombuffer(data, np.uint8)
+    newline_offsets = _line_ends(raw, has_carriage_return)
+    first_line = pieces.next_line
+    pieces.next_line += len(newline_offsets)
+    if raw.max() >= _FIRST_NON_ASCII:
+        try:
+            codecs.utf_8_decode(data, "strict", True)
+        except UnicodeDecodeError:
+            raise NotUtf8 from None
+    invalid: list[tuple[int | None, int, int, str]] = []
+
+    def invalid_row(row: Any) -> str:
+        invalid.append((row.number, row.expected_columns, row.actual_columns, row.text))
+        return "skip" if not threads else "error"
+
+    try:
+        rows = _parse(data, names, row_types, threads, invalid_row)
+    except pa.ArrowInvalid:
+        if invalid and threads:
+            raise MalformedRowsFound from None
+        raise
+    # pyarrow numbers a malformed row among the non-empty lines, from 1.
+    malformed = np.array([number - 1 for number, *_ in invalid if number is not None], np.int64)
+    invalid_rows = []
+    if invalid:
+        non_empty = _lines(data, newline_offsets)[2]
+        invalid_rows = [
+            InvalidRow(
+                first_line + int(non_empty[number - 1])
+                if number is not None and number <= len(non_empty)
+                else first_line,
+                expected,
+                actual,
+                text,
+            )
+            for number, expected, actual, text in invalid
+        ]
+    return CsvChunk(
+        rows, invalid_rows, data, newline_offsets, first_line, malformed, names, all_types
+    )
+
+
+def _line_ends(raw: NDArray[np.uint8], has_carriage_return: bool) -> NDArray[np.int64]:
+    """Offsets of the line ends: each LF, and each CR not followed by a LF (old Mac files)."""
+    ends = np.flatnonzero(raw == _NEWLINE)
+    if not has_carriage_return:
+        return ends
+    returns = np.flatnonzero(raw == _CARRIAGE_RETURN)
+    following = np.minimum(returns + 1, len(raw) - 1)
+    lone = returns[(returns + 1 == len(raw)) | (raw[following] != _NEWLINE)]
+    return np.union1d(ends, lone) if len(lone) else ends
+
+
+def _lines(
+    data: memoryview, ends: NDArray[np.int64]
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """Start and line-end offset (``ends``) of each line of ``data``, and the indices of the
+    non-empty lines (pyarrow skips lines that are empty or hold only a carriage return)."""
+    raw = np.frombuffer(data, np.uint8)
+    starts = np.empty_like(ends)
+    starts[:1] = 0
+    starts[1:] = ends[:-1] + 1
+    length = ends - starts
+    empty = (length == 0) | ((length == 1) & (raw[starts] == _CARRIAGE_RETURN))
+    return starts, ends, np.flatnonzero(~empty)
+
+
+def _parse(
+    data: memoryview,
+    names: Sequence[str],
+    types: Mapping[str, pa.DataType],
+    threads: bool,
+    invalid_row: Any = None,
+) -> pa.Table:
+    return pacsv.read_csv(
+        pa.BufferReader(pa.py_buffer(data)),
+        read_options=pacsv.ReadOptions(
+            column_names=list(names), block_size=PARSE_BLOCK_BYTES, use_threads=threads
+        ),
+        parse_options=pacsv.ParseOptions(invalid_row_handler=invalid_row),
+        convert_options=pacsv.ConvertOptions(
+            column_types=dict(types),
+            include_columns=list(types),
+            strings_can_be_null=False,
+            quoted_strings_can_be_null=False,
+        ),
+    )

@@ -1,0 +1,147 @@
+"""The chunked CSV reader: chunk edges, line numbers, the rows cut out again, and fallbacks.
+
+Each case reads a real fixture in altered form and compares with the plain read of the
+fixture, whose counts tests/test_ais_readers.py checks independently.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from colregs9_cli.ais import csv_chunks
+from colregs9_cli.ais.load import AisData, load_ais
+from colregs9_cli.errors import InputFileError
+from colregs9_cli.query import load_query
+
+ROOT = Path(__file__).resolve().parents[1]
+DMA26 = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
+MARINECADASTRE = ROOT / "fixtures" / "ais" / "marinecadastre_2023-01-11_sample.csv"
+
+
+def _counts(data: AisData) -> dict[str, object]:
+    """The ledger without its examples, which depend on the blocks (one per reason and block)."""
+    return {k: v for k, v in data.ledger.to_dict().items() if k != "reject_examples"}
+
+
+def _same(a: AisData, b: AisData) -> None:
+    pd.testing.assert_frame_equal(a.positions, b.positions)
+    pd.testing.assert_frame_equal(a.dimension_reports, b.dimension_reports)
+    assert _counts(a) == _counts(b)
+    for reason, examples in b.ledger.examples.items():
+        assert a.ledger.examples[reason][0] == examples[0]
+
+
+def _box_query(tmp_path: Path) -> Path:
+    """Part of the Kattegat: 6 of the fixture's position rows (one a duplicate)."""
+    path = tmp_path / "kattegat.toml"
+    path.write_text(
+        'name = "kattegat"\n[region]\nlat_min = 57.0\nlat_max = 58.0\n'
+        "lon_min = 9.0\nlon_max = 12.5\n"
+    )
+    return path
+
+
+@pytest.mark.parametrize("chunk_bytes", [1, 97, 400, 4096])
+@pytest.mark.parametrize("fixture", [DMA26, MARINECADASTRE])
+def test_any_chunk_size_reads_the_same(
+    monkeypatch: pytest.MonkeyPatch, fixture: Path, chunk_bytes: int
+) -> None:
+    """Chunks shorter than a line, a few lines, and the whole file give the same result."""
+    whole = load_ais([fixture])
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
+    _same(load_ais([fixture]), whole)
+
+
+def test_rows_cut_out_of_a_chunk_are_the_right_rows(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With a query, only some rows of each chunk are parsed again in full: same values."""
+    query = load_query(_box_query(tmp_path))
+    whole = load_ais([DMA26])
+    inside = whole.positions[
+        whole.positions["lat_deg"].between(57.0, 58.0)
+        & whole.positions["lon_deg"].between(9.0, 12.5)
+    ].reset_index(drop=True)
+    assert len(inside) == 5  # COLOR MAGIC, HUMBRIA SEAWAYS, KYST-FRB14, TRANS FJELL, FALKSKAR II
+    for chunk_bytes in (500, csv_chunks.CHUNK_BYTES):
+        monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
+        pd.testing.assert_frame_equal(load_ais([DMA26], query=query).positions, inside)
+
+
+def test_blank_lines_and_crlf_keep_file_line_numbers(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    lines = DMA26.read_text().splitlines()
+    edited = [lines[0], "", lines[1] + ",extra", "", lines[2].replace("57.236367", "north")]
+    edited += lines[3:]
+    path = tmp_path / "blank.csv"
+    path.write_bytes(("\r\n".join(edited) + "\r\n").encode())
+    for chunk_bytes in (300, csv_chunks.CHUNK_BYTES):
+        monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
+        data = load_ais([path])
+        examples = " | ".join(data.ledger.examples["unparseable"])
+        assert f"{path}:3: expected 26 fields, found 27" in examples
+        assert f"{path}:5: latitude is not a number: 'north'" in examples
+        assert data.ledger.rows_read == 20 and data.ledger.balanced
+        kept = load_ais([DMA26]).positions
+        assert len(data.positions) == len(kept) - 2  # the two broken rows
+
+
+def test_lone_carriage_returns_end_lines(tmp_path: Path) -> None:
+    """Old Mac line ends: the same rows, and line numbers still count lines."""
+    path = tmp_path / "mac.csv"
+    path.write_bytes(DMA26.read_bytes().replace(b"\r\n", b"\n").replace(b"\n", b"\r"))
+    data, plain = load_ais([path]), load_ais([DMA26])
+    pd.testing.assert_frame_equal(data.positions, plain.positions)
+    assert _counts(data) == _counts(plain)
+    assert data.ledger.examples["not_a_vessel"] == [f"{path}:13: mobile type 'AtoN'"]
+
+
+def test_rows_that_do_not_match_lines_parse_the_chunk_whole(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The guard for a chunk whose rows and lines differ: the whole chunk, all columns."""
+    lines = csv_chunks._lines
+
+    def one_line_short(data, ends):  # type: ignore[no-untyped-def]
+        starts, ends, non_empty = lines(data, ends)
+        return starts, ends, non_empty[:-1]
+
+    plain = load_ais([DMA26])
+    monkeypatch.setattr(csv_chunks, "_lines", one_line_short)
+    for chunk_bytes in (600, csv_chunks.CHUNK_BYTES):
+        monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
+        data = load_ais([DMA26])
+        pd.testing.assert_frame_equal(data.positions, plain.positions)
+        pd.testing.assert_frame_equal(data.dimension_reports, plain.dimension_reports)
+        assert _counts(data) == _counts(plain)
+
+
+def test_a_bad_byte_in_a_column_not_converted_is_still_an_error(tmp_path: Path) -> None:
+    """Names are converted only for the rows kept; the chunk's bytes are checked whole."""
+    query = load_query(_box_query(tmp_path))
+    path = tmp_path / "latin1.csv"
+    path.write_bytes(DMA26.read_bytes().replace(b"ARRHENIUS", b"ARRH\xe6NIUS"))  # outside
+    with pytest.raises(InputFileError, match=r"latin1\.csv:8: byte 0xe6 at offset \d+"):
+        load_ais([path], query=query)
+
+
+def test_text_in_a_column_converted_only_for_kept_rows(tmp_path: Path) -> None:
+    """SOG text in a kept row sends the file through the all-text read: a null SOG."""
+    lines = DMA26.read_text().splitlines()
+    target = next(i for i, line in enumerate(lines) if ",Class A," in line and i > 0)
+    fields = lines[target].split(",")
+    fields[7] = "fast"
+    lines[target] = ",".join(fields)
+    path = tmp_path / "sog.csv"
+    path.write_text("\n".join(lines) + "\n")
+    data = load_ais([path])
+    plain = load_ais([DMA26])
+    assert _counts(data) == _counts(plain)
+    mmsi = int(fields[2])
+    changed = data.positions[data.positions["mmsi"] == mmsi]["sog_kn"]
+    assert changed.isna().any()
+    assert data.positions.drop(columns="sog_kn").equals(plain.positions.drop(columns="sog_kn"))
