@@ -247,11 +247,13 @@ def turning_arcs(
     )
 
 
+@functools.lru_cache(maxsize=64)
 def _unit_ellipse(a_m: float, b_m: float, n_vertices: int) -> tuple[NDArray, NDArray]:
     """Body-frame (forward, starboard) vertices, closed, inscribed in the ellipse."""
     t_rad = np.linspace(0.0, 2.0 * np.pi, n_vertices + 1)
     forward_m, starboard_m = a_m * np.cos(t_rad), b_m * np.sin(t_rad)
     forward_m[-1], starboard_m[-1] = forward_m[0], starboard_m[0]
+    forward_m.flags.writeable = starboard_m.flags.writeable = False
     return forward_m, starboard_m
 
 
@@ -267,18 +269,24 @@ def ellipse_polygons(
 
     Coordinates are built with numpy and turned into polygons in one shapely call; x is east.
     """
-    north = np.atleast_1d(np.asarray(north_m, dtype=float))[:, None]
-    east = np.atleast_1d(np.asarray(east_m, dtype=float))[:, None]
-    heading_rad = np.radians(np.atleast_1d(np.asarray(heading_deg, dtype=float)))[:, None]
-    forward_m, starboard_m = _unit_ellipse(a_m, b_m, n_vertices)
+    north = np.atleast_1d(np.asarray(north_m, dtype=float))
+    east = np.atleast_1d(np.asarray(east_m, dtype=float))
+    heading_rad = np.radians(np.atleast_1d(np.asarray(heading_deg, dtype=float)))
+    forward_m, starboard_m = _unit_ellipse(float(a_m), float(b_m), n_vertices)
     cos_h, sin_h = np.cos(heading_rad), np.sin(heading_rad)
-    vertex_north = north + forward_m * cos_h - starboard_m * sin_h
-    vertex_east = east + forward_m * sin_h + starboard_m * cos_h
-    count, ring = vertex_north.shape
+    count, ring = len(north), len(forward_m)
+    # (x, y) = (east, north) interleaved, written in place: the layout from_ragged_array takes.
+    coords = np.empty((count, ring, 2))
+    np.multiply.outer(sin_h, forward_m, out=coords[:, :, 0])
+    coords[:, :, 0] += np.multiply.outer(cos_h, starboard_m)
+    coords[:, :, 0] += east[:, None]
+    np.multiply.outer(cos_h, forward_m, out=coords[:, :, 1])
+    coords[:, :, 1] -= np.multiply.outer(sin_h, starboard_m)
+    coords[:, :, 1] += north[:, None]
     # One ragged-array call builds every ring and polygon (about twice shapely.polygons' speed).
     return shapely.from_ragged_array(
         shapely.GeometryType.POLYGON,
-        np.column_stack([vertex_east.ravel(), vertex_north.ravel()]),
+        coords.reshape(-1, 2),
         (np.arange(0, count * ring + 1, ring), np.arange(count + 1)),
     )
 
@@ -297,14 +305,14 @@ def restricted_flags(
     Exact for the polygonal ellipses, and vectorised. A position whose centre is outside the
     water is restricted. Runs of ``_CHUNK_POINTS`` consecutive positions whose bounding circle,
     widened by the ellipse's outer radius max(a, b), stays clear of the water's boundary are
-    decided by one prepared distance query (clear if the centre is in the water). Only the
-    positions left build their ellipses, all tested in one ``shapely.contains_properly`` call.
+    decided by one prepared distance query and the run's centre (all clear if it is in the
+    water). Only the positions left build their ellipses, all tested in one
+    ``shapely.contains_properly`` call.
     (Per-position distance filters were measured and cost more than they save.)
     """
     n = len(north_m)
-    inside = np.asarray(shapely.contains_xy(index.water, east_m, north_m), dtype=bool)
     if n == 0 or shapely.is_empty(index.boundary):
-        return ~inside
+        return ~np.asarray(shapely.contains_xy(index.water, east_m, north_m), dtype=bool)
     # A hair outside, so that rounding never calls a touching polygon clear.
     outer_m = max(a_m, b_m) * (1.0 + 1e-9)
     starts = np.arange(0, n, _CHUNK_POINTS)
@@ -318,8 +326,15 @@ def restricted_flags(
     near_chunks = shapely.dwithin(
         index.boundary, shapely.points(centre_east, centre_north), spread_m + outer_m
     )
-    restricted = ~inside
-    exact = np.flatnonzero(near_chunks[chunk] & inside)
+    # A far run lies in one face of the boundary: in the water or not, as its centre is.
+    far = ~near_chunks
+    centre_in_water = np.ones(len(starts), dtype=bool)
+    centre_in_water[far] = shapely.contains_xy(index.water, centre_east[far], centre_north[far])
+    restricted = ~centre_in_water[chunk]
+    near = np.flatnonzero(near_chunks[chunk])
+    inside = np.asarray(shapely.contains_xy(index.water, east_m[near], north_m[near]), dtype=bool)
+    restricted[near[~inside]] = True
+    exact = near[inside]
     if len(exact):
         ellipses = ellipse_polygons(
             north_m[exact], east_m[exact], heading_deg[exact], a_m, b_m, n_vertices

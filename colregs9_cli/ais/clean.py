@@ -149,6 +149,9 @@ def to_float(values: pa.Array | pa.ChunkedArray) -> tuple[pa.Array, BoolArray]:
 
 
 def to_numpy_float(values: pa.Array) -> FloatArray:
+    """Nulls as NaN (filling first is about twice as fast as letting to_numpy do it)."""
+    if values.null_count:
+        values = pc.fill_null(values, pa.scalar(np.nan, pa.float64()))
     return np.asarray(values.to_numpy(zero_copy_only=False), dtype=np.float64)
 
 

@@ -174,7 +174,7 @@ class _FileResult:
     name: str
     ledger: RejectsLedger = field(default_factory=RejectsLedger)
     kept: list[pa.Table] = field(default_factory=list)
-    dimension_parts: list[pd.DataFrame] = field(default_factory=list)
+    dimension_parts: list[pa.Table] = field(default_factory=list)
     layout: str = ""
     sha256: str = ""
 
@@ -194,10 +194,25 @@ class _FileResult:
         counts = table.group_by(["mmsi", *DIMENSIONS], use_threads=False).aggregate(
             [([], "count_all")]
         )
-        frame = counts.select(["mmsi", *DIMENSIONS, "count_all"]).to_pandas(use_threads=False)
-        self.dimension_parts.append(frame.rename(columns={"count_all": "n_reports"}))
+        self.dimension_parts.append(
+            counts.select(["mmsi", *DIMENSIONS, "count_all"]).rename_columns(
+                DIMENSION_REPORT_COLUMNS
+            )
+        )
         if len(self.dimension_parts) >= _DIMENSION_PARTS_BEFORE_MERGE:
-            self.dimension_parts = [_merge_counts(self.dimension_parts)]
+            self.dimension_parts = [_sum_counts(self.dimension_parts)]
+
+
+def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
+    """Per-block counts of (mmsi, dimensions) combined into one count per combination."""
+    summed = (
+        pa.concat_tables(parts)
+        .group_by(["mmsi", *DIMENSIONS], use_threads=False)
+        .aggregate([("n_reports", "sum")])
+    )
+    return summed.select(["mmsi", *DIMENSIONS, "n_reports_sum"]).rename_columns(
+        DIMENSION_REPORT_COLUMNS
+    )
 
 
 def _count_combinations(frame: pd.DataFrame) -> pd.DataFrame:
@@ -678,12 +693,12 @@ def _to_canonical(source: Source, table: pa.Table) -> pa.Table:
 @dataclass
 class _Collected:
     kept: list[pa.Table] = field(default_factory=list)
-    dimension_parts: list[pd.DataFrame] = field(default_factory=list)
+    dimension_parts: list[pa.Table] = field(default_factory=list)
 
     def extend(self, part: _FileResult) -> None:
         self.kept.extend(part.kept)
         if part.dimension_parts:
-            self.dimension_parts.append(_merge_counts(part.dimension_parts))
+            self.dimension_parts.append(_sum_counts(part.dimension_parts))
 
     def finish(self, ledger: RejectsLedger) -> tuple[pd.DataFrame, pd.DataFrame]:
         """Sort, drop exact duplicates (ledger), and count the used rows."""
@@ -691,7 +706,11 @@ class _Collected:
         positions = _to_pandas(table)
         positions = positions.sort_values(["mmsi", "timestamp"], kind="stable", ignore_index=True)
         duplicate = positions.duplicated(keep="first").to_numpy()
-        counts = _merge_counts(self.dimension_parts) if self.dimension_parts else _empty_counts()
+        counts = (
+            _sum_counts(self.dimension_parts).to_pandas()
+            if self.dimension_parts
+            else _empty_counts()
+        )
         if duplicate.any():
             dropped = positions.loc[duplicate]
             first = dropped.iloc[0]

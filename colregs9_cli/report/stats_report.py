@@ -121,8 +121,10 @@ def format_markdown(result: StatsResult, query_name: str) -> str:
 
 def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     """Three histograms (length, breadth, draught) of the counted units' values."""
-    # A bare Figure renders with Agg on save, without pyplot's backend machinery.
-    figure = Figure(figsize=(13, 4), layout="constrained")
+    # A bare Figure renders with Agg on save, without pyplot's backend machinery. Fixed
+    # margins: a layout engine would double the time of drawing these three panels.
+    figure = Figure(figsize=(13, 4))
+    figure.subplots_adjust(left=0.05, right=0.99, bottom=0.13, top=0.82, wspace=0.22)
     axes = figure.subplots(1, 3)
     for axis, (dimension, label) in zip(axes, DIMENSION_LABELS.items(), strict=True):
         values = result.samples[dimension].dropna().to_numpy(dtype=float)
