@@ -9,9 +9,10 @@ on the same file in the same run, times each tool in its own subprocess:
 - ``duckdb``: ``SELECT * FROM read_csv(...) WHERE box``.
 
 Wall time is measured by the parent around the subprocess (interpreter start and imports
-included, the same for all); with ``--repeat N`` the fastest run counts, the usual choice on
-a machine shared with other work. CPU time (user + system, all threads) is the child's own.
-Peak RSS is the child's ``VmHWM`` from ``/proc/self/status`` at exit: unlike ``ru_maxrss``,
+included, the same for all); with ``--repeat N`` the tools take turns N times (round-robin, so
+that a slow spell of the machine hits all of them) and each tool's fastest run counts, the
+usual choice on a machine shared with other work. CPU time (user + system, all threads) is
+the child's own. Peak RSS is the child's ``VmHWM`` from ``/proc/self/status`` at exit: unlike ``ru_maxrss``,
 which Linux carries over from the parent across fork and exec, it starts afresh in the new
 process, so each figure belongs to one tool. The files are generated in a subprocess too.
 Every tool reports the rows and vessels it selected, so that the results can be seen to agree.
@@ -136,8 +137,12 @@ def main() -> None:
             )
             size_mb = csv_path.stat().st_size / 1e6
             print(f"\n{rows:,} rows, {size_mb:,.0f} MB")
-            for tool in TOOLS:
-                runs = [_measure(tool, csv_path, workdir / "out") for _ in range(args.repeat)]
+            # Round-robin, so that a slow spell of the machine hits every tool alike.
+            runs_of: dict[str, list[dict[str, Any]]] = {tool: [] for tool in TOOLS}
+            for _ in range(args.repeat):
+                for tool in TOOLS:
+                    runs_of[tool].append(_measure(tool, csv_path, workdir / "out"))
+            for tool, runs in runs_of.items():
                 result = {
                     "rows_in_file": rows,
                     "file_mb": size_mb,
