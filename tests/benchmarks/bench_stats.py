@@ -14,8 +14,9 @@ that a slow spell of the machine hits all of them) and each tool's fastest run c
 usual choice on a machine shared with other work. CPU time (user + system, all threads) is
 the child's own. Peak RSS is the child's ``VmHWM`` from ``/proc/self/status`` at exit:
 unlike ``ru_maxrss``, which Linux carries over from the parent across fork and exec, it starts
-afresh in the new process, so each figure belongs to one tool. The files are generated in a subprocess too.
-Every tool reports the rows and vessels it selected, so that the results can be seen to agree.
+afresh in the new process, so each figure belongs to one tool. The files are generated in a
+subprocess too. Every tool reports the rows and vessels it selected, so that the results can
+be seen to agree.
 
 Usage: python tests/benchmarks/bench_stats.py [--sizes 2500000 5000000] [--repeat 1]
 Needs the ``bench`` extra (polars, duckdb).
