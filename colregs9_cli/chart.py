@@ -117,9 +117,13 @@ class Chart:
     _water: dict[tuple[float, float], WaterIndex] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
+    _coverage_boundary: Any = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         shapely.prepare(self.coverage)
+        coverage_boundary = shapely.boundary(self.coverage)
+        shapely.prepare(coverage_boundary)
+        object.__setattr__(self, "_coverage_boundary", coverage_boundary)
 
     def water_index(self, draught_m: float, ukc_m: float = 0.0) -> WaterIndex:
         """The prepared navigable water and its boundary, built once per (draught, UKC)."""
@@ -147,11 +151,21 @@ class Chart:
 
     def covers(self, north_m: ArrayLike, east_m: ArrayLike) -> NDArray[np.bool_]:
         """True where a local-frame position lies inside the charted extent (boundary included)."""
-        return np.asarray(
-            shapely.intersects_xy(
-                self.coverage, np.asarray(east_m, dtype=float), np.asarray(north_m, dtype=float)
-            ),
-            dtype=bool,
+        return np.atleast_1d(
+            np.asarray(
+                shapely.intersects_xy(
+                    self.coverage,
+                    np.asarray(east_m, dtype=float),
+                    np.asarray(north_m, dtype=float),
+                ),
+                dtype=bool,
+            )
+        )
+
+    def covers_disk(self, north_m: float, east_m: float, radius_m: float) -> bool:
+        """Whether every point within ``radius_m`` of the position lies inside the extent."""
+        return bool(self.covers(north_m, east_m)[0]) and not bool(
+            shapely.dwithin(self._coverage_boundary, shapely.Point(east_m, north_m), radius_m)
         )
 
     def navigable_area_km2(self, draught_m: float, ukc_m: float = 0.0) -> float:

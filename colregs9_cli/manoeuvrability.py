@@ -324,7 +324,9 @@ def restricted_flags(
         np.hypot(east_m - centre_east[chunk], north_m - centre_north[chunk]), starts
     )
     near_chunks = shapely.dwithin(
-        index.boundary, shapely.points(centre_east, centre_north), spread_m + outer_m
+        index.boundary,
+        shapely.points(np.column_stack([centre_east, centre_north])),
+        spread_m + outer_m,
     )
     # A far run lies in one face of the boundary: in the water or not, as its centre is.
     far = ~near_chunks
@@ -447,8 +449,13 @@ def assess_manoeuvrability(
         restricted = np.zeros(len(arcs.arc), dtype=bool)
         restriction = Restriction.UNKNOWN
     else:
-        covered_all = chart.covers(np.append(arcs.north_m, north_m), np.append(arcs.east_m, east_m))
-        covered, start_covered = covered_all[:-1], bool(covered_all[-1])
+        # No projected position is farther from the start than the path sailed.
+        reach_m = speed_mps * params.step_s * params.steps
+        if chart.covers_disk(north_m, east_m, reach_m):
+            covered, start_covered = np.ones(len(arcs.arc), dtype=bool), True
+        else:
+            covered = chart.covers(arcs.north_m, arcs.east_m)
+            start_covered = bool(chart.covers(north_m, east_m)[0])
         restricted = restricted_flags(
             chart.water_index(draught_m, params.ukc_m),
             arcs.north_m,

@@ -278,6 +278,29 @@ def test_uncovered_positions_are_never_clear() -> None:
     assert verdict(RestrictionPolicy.ANY, ARC, clear, covered, False) is Restriction.UNKNOWN
 
 
+def test_covers_disk_is_the_whole_disk_inside_the_extent() -> None:
+    chart = _square_chart(200.0)  # extent: the square of side 2 km around the origin
+    assert chart.covers_disk(0.0, 0.0, 999.0)
+    assert not chart.covers_disk(0.0, 0.0, 1000.0)  # touches the edge
+    assert not chart.covers_disk(900.0, 0.0, 150.0)
+    assert not chart.covers_disk(1500.0, 0.0, 1.0)  # centre outside
+
+
+@pytest.mark.parametrize(("start_north_m", "expected_uncovered"), [(0.0, 0), (900.0, 1)])
+def test_arcs_leaving_the_extent_mark_their_positions_uncovered(
+    start_north_m: float, expected_uncovered: int
+) -> None:
+    """Heading north at 7 kn the arcs reach 648 m ahead: from 900 m north they leave the
+    2 km square (whose north edge is at 1,000 m); from the origin they stay inside."""
+    chart = _square_chart(-500.0)  # the shoal is south of every arc
+    assessment = assess_manoeuvrability(
+        chart, start_north_m, 0.0, 0.0, SEVEN_KN_MPS, 50.0, 9.0, 5.0, ManoeuvrabilityParams()
+    )
+    outside = np.asarray(assessment.north_m) > 1000.0
+    np.testing.assert_array_equal(assessment.covered, ~outside)
+    assert bool(outside.any()) == bool(expected_uncovered)
+
+
 def test_rate_of_swing_column_is_360_over_the_circumference() -> None:
     table = reference_vessels()
     assert len(table) == 14
