@@ -130,7 +130,7 @@ def test_a_bad_byte_in_a_column_not_converted_is_still_an_error(tmp_path: Path) 
 
 
 def test_text_in_a_column_converted_only_for_kept_rows(tmp_path: Path) -> None:
-    """SOG text in a kept row sends the file through the all-text read: a null SOG."""
+    """SOG text in a kept row: that row is read again as text, its SOG becomes null."""
     lines = DMA26.read_text().splitlines()
     target = next(i for i, line in enumerate(lines) if ",Class A," in line and i > 0)
     fields = lines[target].split(",")
@@ -145,3 +145,49 @@ def test_text_in_a_column_converted_only_for_kept_rows(tmp_path: Path) -> None:
     changed = data.positions[data.positions["mmsi"] == mmsi]["sog_kn"]
     assert changed.isna().any()
     assert data.positions.drop(columns="sog_kn").equals(plain.positions.drop(columns="sog_kn"))
+
+
+def _chunks_of(path: Path) -> list[csv_chunks.CsvChunk]:
+    from colregs9_cli.ais import dma
+
+    names = path.read_text().splitlines()[0].lower().lstrip("# ").split(",")
+    with path.open("rb") as stream:
+        return list(
+            csv_chunks.read_chunks(
+                stream,
+                names,
+                True,
+                row_columns=dma.row_columns(True),
+                all_columns=dma.read_columns(True),
+                numeric=dma.NUMERIC_COLUMNS,
+            )
+        )
+
+
+def test_a_bad_row_costs_its_chunk_not_the_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Text in a number column makes only its chunk text; a malformed row makes only its
+    chunk parse again on one thread."""
+    lines = DMA26.read_text().splitlines()
+    lines[3] = lines[3].replace("57.459803", "north")  # file line 4
+    lines[15] = lines[15] + ",extra"  # file line 16
+    path = tmp_path / "bad.csv"
+    path.write_text("\n".join(lines) + "\n")
+    parses: list[bool] = []
+    parse = csv_chunks._parse
+
+    def recording_parse(data, names, types, threads, invalid_row=None):  # type: ignore[no-untyped-def]
+        parses.append(threads)
+        return parse(data, names, types, threads, invalid_row)
+
+    monkeypatch.setattr(csv_chunks, "_parse", recording_parse)
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", 700)
+    chunks = _chunks_of(path)
+    first_lines = [chunk.line_of(0) for chunk in chunks]
+    text = [chunk.text for chunk in chunks]
+    assert sum(text) == 1 and text[first_lines.index(max(n for n in first_lines if n <= 4))]
+    invalid = [bad.line for chunk in chunks for bad in chunk.invalid_rows]
+    assert invalid == [16]
+    assert parses.count(False) == 1  # only the chunk with line 16, on one thread
+    assert len(chunks) > 5

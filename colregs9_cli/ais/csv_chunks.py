@@ -3,7 +3,7 @@
 A DMA day file is mostly rows outside the query. Converting all of their columns is what
 makes a plain streaming read slow, so each chunk (``CHUNK_BYTES`` of whole lines) is parsed
 by pyarrow's ``read_csv`` on all cores with only the columns that every row needs
-(``row_types``: position, MMSI, mobile type, dimensions). The few rows that the pipeline
+(``row_columns``: position, MMSI, mobile type, dimensions). The few rows that the pipeline
 keeps are then cut out of the chunk's bytes by their line offsets and parsed again with all
 columns (``CsvChunk.take``). The next chunk is read and parsed on a worker thread while the
 caller works on the current one, so memory stays at about two chunks.
@@ -13,10 +13,14 @@ line end (LF, CRLF or a lone CR), quoted or not, and skips empty lines. Should a
 non-empty lines not match its rows one to one, the chunk is parsed whole with all columns
 instead, which is slower but gives the same rows (line numbers are then the chunk's first).
 
-Malformed rows (a wrong number of fields) are reported with their file line when
-``threads`` is false. Parsing on several threads loses line numbers, so there the first
-malformed row stops the read with ``MalformedRowsFound``, for the caller to read again on
-one thread.
+Each chunk falls back on its own, so a bad row costs one chunk, not the file:
+
+- Malformed rows (a wrong number of fields) are skipped and reported with their file line.
+  Parsing on several threads loses line numbers, so a chunk with one is parsed again on one
+  thread.
+- The ``numeric`` columns are read as numbers. A chunk where one holds text (``north`` for a
+  latitude) is parsed again with every column as text, and the caller's cleaning sorts the
+  values out (``CsvChunk.text`` tells). The same holds for the rows cut out by ``take``.
 """
 
 from __future__ import annotations
@@ -37,10 +41,6 @@ CHUNK_BYTES = 16 * 1024 * 1024
 # pyarrow's parallel unit inside a chunk.
 PARSE_BLOCK_BYTES = 4 * 1024 * 1024
 _NEWLINE, _CARRIAGE_RETURN, _FIRST_NON_ASCII = 10, 13, 128
-
-
-class MalformedRowsFound(Exception):
-    """A row with a wrong number of fields, met while parsing on several threads."""
 
 
 class NotUtf8(Exception):
@@ -66,17 +66,17 @@ class CsvChunk:
         newline_offsets: NDArray[np.int64],
         first_line: int,
         malformed: NDArray[np.int64],
-        names: Sequence[str],
-        all_types: Mapping[str, pa.DataType],
+        layout: _Layout,
+        text: bool,
     ) -> None:
         self.rows = rows
         self.invalid_rows = invalid_rows
+        self.text = text
         self._data = data
         self._newline_offsets = newline_offsets
         self._first_line = first_line
         self._malformed = malformed  # their indices among the non-empty lines
-        self._names = names
-        self._all_types = all_types
+        self._layout = layout
 
     @functools.cached_property
     def _row_lines(self) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]] | None:
@@ -96,8 +96,9 @@ class CsvChunk:
 
     def take(self, rows: NDArray[np.int64]) -> pa.Table:
         """All columns of the given rows (indices into ``rows``), in that order."""
+        columns = self._layout.all_columns
         if self._row_lines is None:
-            whole = _parse(self._data, self._names, self._all_types, threads=False)
+            whole, _ = _parse_numbers_or_text(self._data, self._layout, columns, self.text)
             return whole.take(pa.array(rows, pa.int64()))
         _, starts, ends = self._row_lines
         data = self._data
@@ -105,27 +106,39 @@ class CsvChunk:
             data[start : end + 1]
             for start, end in zip(starts[rows].tolist(), ends[rows].tolist(), strict=True)
         )
-        return _parse(memoryview(lines), self._names, self._all_types, threads=False)
+        table, _ = _parse_numbers_or_text(memoryview(lines), self._layout, columns, self.text)
+        return table
+
+
+@dataclass(frozen=True)
+class _Layout:
+    names: Sequence[str]
+    row_columns: Sequence[str]
+    all_columns: Sequence[str]
+    numeric: frozenset[str]
 
 
 def read_chunks(
     stream: BinaryIO,
     names: Sequence[str],
     has_header: bool,
-    row_types: Mapping[str, pa.DataType],
-    all_types: Mapping[str, pa.DataType],
-    threads: bool,
+    row_columns: Sequence[str],
+    all_columns: Sequence[str],
+    numeric: Sequence[str],
 ) -> Generator[CsvChunk, None, None]:
     """The chunks of a CSV stream, each parsed (on a worker thread) while the last is used.
 
-    Raises ``pa.ArrowInvalid`` for data pyarrow cannot read, ``MalformedRowsFound`` (threads
-    only), ``NotUtf8``, and whatever reading the stream raises.
+    ``names`` are the file's columns; ``row_columns`` are converted for every row,
+    ``all_columns`` for the rows taken; ``numeric`` columns are read as numbers where they
+    can be. Raises ``pa.ArrowInvalid`` for data pyarrow cannot read, ``NotUtf8``, and
+    whatever reading the stream raises.
     """
+    layout = _Layout(names, row_columns, all_columns, frozenset(numeric))
     pieces = _Pieces(stream, first_line=2 if has_header else 1, skip_header=has_header)
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="colregs9-csv") as pool:
 
         def submit() -> Future[CsvChunk | None]:
-            return pool.submit(_next_chunk, pieces, names, row_types, all_types, threads)
+            return pool.submit(_next_chunk, pieces, layout)
 
         pending = submit()
         try:
@@ -190,13 +203,7 @@ def _first_line_end(buffer: bytearray, end: int) -> int:
     return newline + 1 if newline != -1 else end
 
 
-def _next_chunk(
-    pieces: _Pieces,
-    names: Sequence[str],
-    row_types: Mapping[str, pa.DataType],
-    all_types: Mapping[str, pa.DataType],
-    threads: bool,
-) -> CsvChunk | None:
+def _next_chunk(pieces: _Pieces, layout: _Layout) -> CsvChunk | None:
     piece = pieces.read()
     if piece is None:
         return None
@@ -211,17 +218,7 @@ def _next_chunk(
         except UnicodeDecodeError:
             raise NotUtf8 from None
     invalid: list[tuple[int | None, int, int, str]] = []
-
-    def invalid_row(row: Any) -> str:
-        invalid.append((row.number, row.expected_columns, row.actual_columns, row.text))
-        return "skip" if not threads else "error"
-
-    try:
-        rows = _parse(data, names, row_types, threads, invalid_row)
-    except pa.ArrowInvalid:
-        if invalid and threads:
-            raise MalformedRowsFound from None
-        raise
+    rows, text = _parse_numbers_or_text(data, layout, layout.row_columns, False, invalid)
     # pyarrow numbers a malformed row among the non-empty lines, from 1.
     malformed = np.array([number - 1 for number, *_ in invalid if number is not None], np.int64)
     invalid_rows = []
@@ -238,9 +235,44 @@ def _next_chunk(
             )
             for number, expected, actual, text in invalid
         ]
-    return CsvChunk(
-        rows, invalid_rows, data, newline_offsets, first_line, malformed, names, all_types
-    )
+    return CsvChunk(rows, invalid_rows, data, newline_offsets, first_line, malformed, layout, text)
+
+
+def _parse_numbers_or_text(
+    data: memoryview,
+    layout: _Layout,
+    columns: Sequence[str],
+    text: bool,
+    invalid: list[tuple[int | None, int, int, str]] | None = None,
+) -> tuple[pa.Table, bool]:
+    """Parse on all cores with numbers as numbers; again on one thread if a row is malformed
+    (for its line number), and again as text if a number column holds text. Returns the
+    table and whether it was read as text. Malformed rows are skipped and go to ``invalid``.
+    """
+    threads = True
+    while True:
+        found: list[tuple[int | None, int, int, str]] = []
+
+        def invalid_row(row: Any, found: list = found, threads: bool = threads) -> str:
+            found.append((row.number, row.expected_columns, row.actual_columns, row.text))
+            return "error" if threads else "skip"
+
+        types = {
+            c: pa.float64() if c in layout.numeric and not text else pa.string() for c in columns
+        }
+        try:
+            table = _parse(data, layout.names, types, threads, invalid_row)
+        except pa.ArrowInvalid as exc:
+            if threads and found:
+                threads = False
+            elif not text and "conversion error" in str(exc):
+                text = True
+            else:
+                raise
+            continue
+        if invalid is not None:
+            invalid.extend(found)
+        return table, text
 
 
 def _line_ends(raw: NDArray[np.uint8], has_carriage_return: bool) -> NDArray[np.int64]:

@@ -32,11 +32,10 @@ are not checked for a bad timestamp or duplicates, so they count as reports as t
 Memory: CSV is read in chunks of whole lines (``csv_chunks.CHUNK_BYTES``); a chunk is
 dropped once its rows in the query are kept, so memory grows with the kept rows, not with
 the file. Only the columns every row needs are converted for every row; the rest only for
-the rows kept and the static reports (see csv_chunks.py). A CSV whose numeric columns hold
-text in a converted row is read a second time with every column as text (the fast first
-pass reads numbers directly). pyarrow parses on several threads, which loses the line
-numbers of malformed rows: a CSV with a malformed row is read again on one thread, so its
-examples name the exact line. NMEA is decoded whole per file (see nmea.py).
+the rows kept and the static reports (see csv_chunks.py). A chunk whose numeric columns
+hold text is parsed again with every column as text, and a chunk with a malformed row again
+on one thread, which gives the row's line; the rest of the file is not affected. NMEA is
+decoded whole per file (see nmea.py).
 """
 
 from __future__ import annotations
@@ -60,7 +59,7 @@ from ..query import Query, everything_query
 from . import dma, marinecadastre
 from .batch import AisBatch
 from .clean import Fields, clean_text, is_vessel, null_outside, valid_mmsi
-from .csv_chunks import CsvChunk, MalformedRowsFound, NotUtf8, read_chunks
+from .csv_chunks import CsvChunk, NotUtf8, read_chunks
 from .detect import CSV_LAYOUTS, LAYOUTS, csv_header, detect_layout
 from .ledger import RejectReason, RejectsLedger
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
@@ -233,37 +232,7 @@ def _read_source(source: Source, fmt: str | None, query: Query, bar: ProgressSin
         return _read_parquet(source, query, bar)
     if layout == "nmea":
         return _read_nmea(source, query, bar)
-    try:
-        return _read_csv_exact(source, layout, head, query, bar, fast=True)
-    except _NeedsTextColumns:
-        return _read_csv_exact(source, layout, head, query, _NO_PROGRESS, fast=False)
-
-
-def _read_csv_exact(
-    source: Source, layout: str, head: bytes, query: Query, bar: ProgressSink, fast: bool
-) -> _FileResult:
-    """Parse on all cores; a file with malformed rows is read again on one thread, which
-    is what gives their line numbers (and those of the rows after them)."""
-    try:
-        return _read_csv(source, layout, head, query, bar, fast=fast, threads=True)
-    except _NeedsLineNumbers:
-        return _read_csv(source, layout, head, query, _NO_PROGRESS, fast=fast, threads=False)
-
-
-class _NeedsTextColumns(Exception):
-    """A numeric column holds text somewhere: read the file again with text columns."""
-
-
-class _NeedsLineNumbers(Exception):
-    """A malformed row was met while parsing on several threads (no line numbers)."""
-
-
-class _NoProgress:
-    def advance(self, amount: float = 1.0) -> None:
-        return None
-
-
-_NO_PROGRESS = _NoProgress()
+    return _read_csv(source, layout, head, query, bar)
 
 
 @dataclass(frozen=True)
@@ -313,13 +282,7 @@ def _csv_layout(layout: str) -> _CsvLayout:
 
 
 def _read_csv(
-    source: Source,
-    layout: str,
-    head: bytes,
-    query: Query,
-    bar: ProgressSink,
-    fast: bool,
-    threads: bool,
+    source: Source, layout: str, head: bytes, query: Query, bar: ProgressSink
 ) -> _FileResult:
     if layout not in CSV_LAYOUTS:
         raise ParameterError(
@@ -334,29 +297,25 @@ def _read_csv(
             f"header does not have; check the file or the --format given"
         )
     result = _FileResult(query, source.name, layout=layout)
-
-    def types(columns: Sequence[str]) -> dict[str, pa.DataType]:
-        return {c: pa.float64() if fast and c in spec.numeric else pa.string() for c in columns}
-
     with open_data(source, bar) as opened:
         chunks = read_chunks(
             opened.stream,
             header.columns,
             header.has_header,
-            row_types=types(spec.row_columns),
-            all_types=types(spec.columns),
-            threads=threads,
+            row_columns=spec.row_columns,
+            all_columns=spec.columns,
+            numeric=spec.numeric,
         )
         try:
             with contextlib.closing(chunks):
                 for chunk in chunks:
                     _csv_chunk(result, spec, chunk)
-        except MalformedRowsFound:
-            raise _NeedsLineNumbers from None
         except NotUtf8:
             raise _non_utf8_error(source) from None
         except pa.ArrowInvalid as exc:
-            raise _csv_error(source, exc, fast) from None
+            raise InputFileError(
+                f"{source.name}: cannot read the CSV ({exc}); check the file"
+            ) from None
         result.sha256 = opened.finish()
     return result
 
@@ -370,13 +329,6 @@ def _non_utf8_error(source: Source) -> InputFileError:
         f"{source.name}:{line}: byte 0x{byte:02x} at offset {offset} is not UTF-8; "
         "convert the file to UTF-8 (e.g. iconv -f latin1 -t utf-8)"
     )
-
-
-def _csv_error(source: Source, exc: pa.ArrowInvalid, fast: bool) -> Exception:
-    message = str(exc)
-    if fast and "conversion error" in message:
-        return _NeedsTextColumns()
-    return InputFileError(f"{source.name}: cannot read the CSV ({message}); check the file")
 
 
 def _csv_chunk(result: _FileResult, spec: _CsvLayout, chunk: CsvChunk) -> None:
