@@ -59,8 +59,8 @@ READ_COLUMNS = (
     "draught",
 )
 ABCD = ("a", "b", "c", "d")
-# Columns the fast path reads as numbers; a file with text in one of them is read again
-# with every column as text (see load.py).
+# Columns read as numbers; a chunk with text in one of them is parsed again with every
+# column as text (see csv_chunks.py).
 NUMERIC_COLUMNS = (
     "mmsi",
     "latitude",
