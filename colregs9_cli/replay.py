@@ -9,13 +9,13 @@ automaton G_d (``rule9.py``) at every step. The encounter's verdict is the one a
 trigger step; the later steps are its time series.
 
 Manoeuvrability (event d3) is estimated for the target with her length, breadth and draught.
-A missing dimension takes the mean of the paper's Table 1 (``DEFAULT_TARGET_DIMENSIONS``)
-and the encounter is flagged ``target_dimensions_defaulted``. No chart, or a target outside
+A missing dimension takes the ``[replay]`` default, the mean of the paper's Table 1, and the
+encounter is flagged ``target_dimensions_defaulted``. No chart, or a target outside
 the chart's coverage, gives ``unknown``: ¬d3 for the automaton, recorded as ``unknown``.
 
 The estimate is made at the trigger step (always: it is the verdict and the figure), and at a
 later step only when G_d reaches D3 there (own ship stand-on, the target not reporting a
-restricted status) and the last estimate is at least ``REASSESS_EVERY_S`` old; otherwise the
+restricted status) and the last estimate is at least ``reassess_every_s`` old; otherwise the
 last estimate is carried forward. Every step of the time series says which step its estimate
 was computed at (``restricted_assessed_utc``).
 
@@ -61,26 +61,12 @@ from .manoeuvrability import (
 )
 from .progress import progress_bar, progress_enabled
 from .query import Query, everything_query, load_query
-from .replay_params import ReplayParams, replay_params_from_table
+from .replay_params import ReplayParams, TargetDimensions, replay_params_from_table
 from .report.manifest import inputs_manifest, jsonable, query_manifest, run_header
 from .report.replay_report import format_summary, write_replay_reports
 from .rule9 import Rule9Assessment, assess_rule9
 from .tracks import Tracks, build_tracks
 from .units import signed_angle_deg
-
-
-@dataclass(frozen=True)
-class TargetDimensions:
-    """Dimensions used for a target that does not report them (the paper's Table 1 means)."""
-
-    length_m: float = 50.1
-    breadth_m: float = 9.2
-    draught_m: float = 3.2
-
-
-DEFAULT_TARGET_DIMENSIONS = TargetDimensions()
-# A manoeuvrability estimate stays valid this long before it is made again (see the docstring).
-REASSESS_EVERY_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -91,8 +77,6 @@ class ReplayRunParams:
     colregs: ColregsParams
     manoeuvrability: ManoeuvrabilityParams
     own_mmsi: tuple[int, ...]
-    target_defaults: TargetDimensions = DEFAULT_TARGET_DIMENSIONS
-    reassess_every_s: float = REASSESS_EVERY_S
 
 
 @dataclass(frozen=True)
@@ -386,7 +370,7 @@ def evaluate_encounter(
         params.colregs,
     )
     length_m, breadth_m, draught_m, defaulted = _target_dimensions(
-        tracks.vessels, encounter.target_mmsi, params.target_defaults
+        tracks.vessels, encounter.target_mmsi, params.replay.target_defaults
     )
     estimator = _Estimator(
         chart=chart,
@@ -394,7 +378,7 @@ def evaluate_encounter(
         length_m=length_m,
         breadth_m=breadth_m,
         draught_m=draught_m,
-        reassess_steps=max(1, round(params.reassess_every_s / tracks.step_s)),
+        reassess_steps=max(1, round(params.replay.reassess_every_s / tracks.step_s)),
     )
     restricted_statuses = params.replay.restricted_nav_statuses
     verdicts: list[Rule9Assessment] = []

@@ -27,6 +27,15 @@ class CourseSource(StrEnum):
 
 
 @dataclass(frozen=True)
+class TargetDimensions:
+    """Dimensions used for a target that does not report them."""
+
+    length_m: float
+    breadth_m: float
+    draught_m: float
+
+
+@dataclass(frozen=True)
 class ReplayParams:
     """The ``[replay]`` table.
 
@@ -43,6 +52,11 @@ class ReplayParams:
     - ``restricted_nav_statuses``: AIS navigational status codes that mean "restricted
       manoeuvrability" for event d2 of the rule 9 automaton (3 restricted manoeuvrability,
       4 constrained by her draught).
+    - ``reassess_every_s``: after the trigger, a manoeuvrability estimate is made again only
+      where G_d reaches D3 and the last one is at least this old (see ``replay.py``).
+    - ``default_length_m``, ``default_breadth_m``, ``default_draught_m``: used for a target
+      that does not report the dimension; the means of the paper's Table 1 (50.1 m, 9.2 m,
+      3.2 m).
     """
 
     step_s: float = 1.0
@@ -55,6 +69,16 @@ class ReplayParams:
     course_change_deg: float = 15.0
     speed_change_frac: float = 0.25
     restricted_nav_statuses: frozenset[int] = frozenset({3, 4})
+    reassess_every_s: float = 10.0
+    default_length_m: float = 50.1
+    default_breadth_m: float = 9.2
+    default_draught_m: float = 3.2
+
+    @property
+    def target_defaults(self) -> TargetDimensions:
+        return TargetDimensions(
+            self.default_length_m, self.default_breadth_m, self.default_draught_m
+        )
 
     def __post_init__(self) -> None:
         positive = (
@@ -65,6 +89,10 @@ class ReplayParams:
             "cpa_req_m",
             "course_change_deg",
             "speed_change_frac",
+            "reassess_every_s",
+            "default_length_m",
+            "default_breadth_m",
+            "default_draught_m",
         )
         for name in positive:
             value = getattr(self, name)

@@ -27,13 +27,12 @@ from colregs9_cli.errors import ParameterError
 from colregs9_cli.query import everything_query
 from colregs9_cli.replay import (
     ENCOUNTER_COLUMNS,
-    TargetDimensions,
     _acted,
     _target_dimensions,
     run_params,
     run_replay,
 )
-from colregs9_cli.replay_params import ReplayParams
+from colregs9_cli.replay_params import ReplayParams, TargetDimensions
 from colregs9_cli.simulate import simulate_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -267,9 +266,12 @@ def test_missing_dimensions_take_the_documented_defaults() -> None:
         {"length_m": [120.0, np.nan], "breadth_m": [20.0, 8.0], "draught_m": [7.5, np.nan]},
         index=pd.Index([1, 2], name="mmsi"),
     )
-    defaults = TargetDimensions()
+    defaults = ReplayParams().target_defaults
     assert _target_dimensions(vessels, 1, defaults) == (120.0, 20.0, 7.5, False)
     assert _target_dimensions(vessels, 2, defaults) == (50.1, 8.0, 3.2, True)
+    longer = ReplayParams(default_length_m=80.0, default_draught_m=4.5).target_defaults
+    assert longer == TargetDimensions(80.0, 9.2, 4.5)
+    assert _target_dimensions(vessels, 2, longer) == (80.0, 8.0, 4.5, True)
 
 
 SCENARIOS = ROOT / "fixtures" / "scenarios"
@@ -372,5 +374,5 @@ def test_estimates_are_fresh_wherever_g_d_reaches_d3(restricted, not_restricted)
         reaches_d3 = series["automaton_path"].str.contains("D3")
         age_s = (series["timestamp"] - series["restricted_assessed_utc"]).dt.total_seconds()
         assert reaches_d3.any()
-        assert (age_s[reaches_d3] < result.params.reassess_every_s).all()
+        assert (age_s[reaches_d3] < result.params.replay.reassess_every_s).all()
         assert (age_s >= 0).all()

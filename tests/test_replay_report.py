@@ -132,9 +132,9 @@ def test_manifest(run) -> None:
     manifest = json.loads((run.out_dir / "run.json").read_text(encoding="utf-8"))
     assert {"version", "parameters", "inputs", "ledger", "counts", "frame"} <= set(manifest)
     parameters = manifest["parameters"]
-    assert {"replay", "colregs", "manoeuvrability", "own_mmsi", "target_defaults"} <= set(
-        parameters
-    )
+    assert {"replay", "colregs", "manoeuvrability", "own_mmsi"} <= set(parameters)
+    assert parameters["replay"]["default_length_m"] == 50.1
+    assert parameters["replay"]["reassess_every_s"] == 10.0
     assert parameters["replay"]["tcpa_act_s"] == 180.0
     assert parameters["replay"]["cpa_req_m"] == 150.0
     assert parameters["replay"]["restricted_nav_statuses"] == [3, 4]
