@@ -228,6 +228,10 @@ def test_missing_and_empty_files(tmp_path: Path) -> None:
     empty.write_bytes(b"")
     with pytest.raises(InputFileError, match=r"empty\.csv: the file is empty"):
         load_ais([empty])
+    header_only = tmp_path / "header.csv"
+    header_only.write_text(DMA26.read_text().splitlines()[0] + "\n\n")
+    with pytest.raises(InputFileError, match=r"header\.csv: no data rows after the header"):
+        load_ais([header_only])
 
 
 def test_unknown_layout(tmp_path: Path) -> None:

@@ -317,6 +317,10 @@ def _read_csv(
                 f"{source.name}: cannot read the CSV ({exc}); check the file"
             ) from None
         result.sha256 = opened.finish()
+    if result.ledger.rows_read == 0:
+        raise InputFileError(
+            f"{source.name}: no data rows after the header; give a file with AIS rows"
+        )
     return result
 
 
