@@ -143,21 +143,65 @@ def test_lone_carriage_returns_end_lines(tmp_path: Path) -> None:
 def test_rows_that_do_not_match_lines_parse_the_chunk_whole(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """The guard for a chunk whose rows and lines differ: the whole chunk, all columns."""
-    lines = csv_chunks._lines
-
-    def one_line_short(data, ends):  # type: ignore[no-untyped-def]
-        starts, ends, non_empty = lines(data, ends)
-        return starts, ends, non_empty[:-1]
-
+    """The guard for records that match no known layout: the whole chunk, all columns."""
     plain = load_ais([DMA26])
-    monkeypatch.setattr(csv_chunks, "_lines", one_line_short)
+    monkeypatch.setattr(csv_chunks, "_records", lambda data, line_ends, count: None)
     for chunk_bytes in (600, csv_chunks.CHUNK_BYTES):
         monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
         data = load_ais([DMA26])
         pd.testing.assert_frame_equal(data.positions, plain.positions)
         pd.testing.assert_frame_equal(data.dimension_reports, plain.dimension_reports)
         assert _counts(data) == _counts(plain)
+
+
+@pytest.mark.parametrize("chunk_bytes", [7, 50, 333, csv_chunks.CHUNK_BYTES])
+def test_crlf_cut_between_cr_and_lf_keeps_line_numbers(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, chunk_bytes: int
+) -> None:
+    """A read may end on the CR of a CRLF; that CR must not end a line of its own."""
+    path = tmp_path / "crlf.csv"
+    path.write_bytes(DMA26.read_bytes().replace(b"\r\n", b"\n").replace(b"\n", b"\r\n"))
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
+    data = load_ais([path])
+    assert data.ledger.examples["not_a_vessel"] == [f"{path}:13: mobile type 'AtoN'"]
+    pd.testing.assert_frame_equal(data.positions, load_ais([DMA26]).positions)
+
+
+def test_mixed_line_ends_cut_after_a_final_cr(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Lone CRs, then CRLFs, with a read ending on a CR: rows and lines stay aligned."""
+    import io
+
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", 12)
+    data = b"a,b\r1,x\r2,y\r\n3,z\r\n4\r\n"
+    chunks = list(
+        csv_chunks.read_chunks(
+            io.BytesIO(data), ["a", "b"], True, ["a", "b"], ["a", "b"], numeric=["a"]
+        )
+    )
+    lines = {
+        chunk.rows.column("a")[row].as_py(): chunk.line_of(row)
+        for chunk in chunks
+        for row in range(chunk.rows.num_rows)
+    }
+    assert lines == {1.0: 2, 2.0: 3, 3.0: 4}
+    assert [bad.line for chunk in chunks for bad in chunk.invalid_rows] == [5]
+
+
+def test_a_quoted_line_end_keeps_rows_and_line_numbers(tmp_path: Path) -> None:
+    """pyarrow accepts a line end inside quotes; the record spans two lines of the file."""
+    lines = DMA26.read_text().splitlines()
+    fields = lines[3].split(",")
+    fields[19] = '"HAM\nBURG"'  # Destination, file line 4 becomes lines 4-5
+    lines[3] = ",".join(fields)
+    lines[14] = lines[14] + ",extra"  # file line 15, now physical line 16
+    path = tmp_path / "quoted.csv"
+    path.write_text("\n".join(lines) + "\n")
+    data = load_ais([path])
+    assert data.ledger.examples["not_a_vessel"] == [f"{path}:14: mobile type 'AtoN'"]
+    assert f"{path}:16: expected 26 fields, found 27" in data.ledger.examples["unparseable"][0]
+    plain = load_ais([DMA26])
+    assert data.ledger.rows_read == plain.ledger.rows_read
+    assert len(data.positions) == len(plain.positions) - 1  # the malformed row
 
 
 def test_a_bad_byte_in_a_column_not_converted_is_still_an_error(tmp_path: Path) -> None:

@@ -8,10 +8,13 @@ keeps are then cut out of the chunk's bytes by their line offsets and parsed aga
 columns (``CsvChunk.take``). The next chunk is read and parsed on a worker thread while the
 caller works on the current one, so memory stays at about two chunks.
 
-A row is one line: pyarrow's default (``newlines_in_values=False``) ends a row at every
-line end (LF, CRLF or a lone CR), quoted or not, and skips empty lines. Should a chunk's
-non-empty lines not match its rows one to one, the chunk is parsed whole with all columns
-instead, which is slower but gives the same rows (line numbers are then the chunk's first).
+A row is one non-empty line (ended by LF, CRLF or a lone CR; pyarrow skips empty lines),
+unless a quoted field holds a line end: chunks with such a record follow the records with
+Python's ``csv`` module to find the lines (slower, but exact). A chunk is cut only at a line
+end, so a quoted line end that falls on a chunk boundary splits its record in two
+unparseable rows, as pyarrow's own block splitting would. Should the records still not match
+the rows (no input known), the chunk is parsed whole with all columns and its line numbers
+are the chunk's first.
 
 Each chunk falls back on its own, so a bad row costs one chunk, not the file:
 
@@ -26,7 +29,9 @@ Each chunk falls back on its own, so a bad row costs one chunk, not the file:
 from __future__ import annotations
 
 import codecs
+import csv
 import functools
+import io
 from collections.abc import Generator, Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
@@ -63,7 +68,7 @@ class CsvChunk:
         rows: pa.Table,
         invalid_rows: list[InvalidRow],
         data: memoryview,
-        newline_offsets: NDArray[np.int64],
+        line_ends: NDArray[np.int64],
         first_line: int,
         malformed: NDArray[np.int64],
         layout: _Layout,
@@ -73,41 +78,74 @@ class CsvChunk:
         self.invalid_rows = invalid_rows
         self.text = text
         self._data = data
-        self._newline_offsets = newline_offsets
+        self._line_ends = line_ends
         self._first_line = first_line
-        self._malformed = malformed  # their indices among the non-empty lines
+        self._malformed = malformed  # their indices among the records
         self._layout = layout
 
     @functools.cached_property
-    def _row_lines(self) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]] | None:
-        """Each row's line index in the chunk and the (start, newline) offsets of that line;
-        None if rows and lines do not match one to one."""
-        starts, ends, non_empty = _lines(self._data, self._newline_offsets)
-        row_line = np.delete(non_empty, self._malformed)
-        if len(row_line) != self.rows.num_rows:
+    def _row_spans(self) -> _Records | None:
+        """Where each row lies in the chunk; None if the records do not match the rows."""
+        records = _records(self._data, self._line_ends, self.rows.num_rows + len(self._malformed))
+        if records is None:
             return None
-        return row_line, starts[row_line], ends[row_line]
+        keep = np.delete(np.arange(len(records.first_line)), self._malformed)
+        return _Records(records.first_line[keep], records.start[keep], records.end[keep])
 
     def line_of(self, row: int) -> int:
-        """The file line (1-based) of a row; the chunk's first line if rows and lines differ."""
-        if self._row_lines is None:
+        """The file line (1-based) where a row starts."""
+        if self._row_spans is None:
             return self._first_line
-        return self._first_line + int(self._row_lines[0][row])
+        return self._first_line + int(self._row_spans.first_line[row])
 
     def take(self, rows: NDArray[np.int64]) -> pa.Table:
         """All columns of the given rows (indices into ``rows``), in that order."""
         columns = self._layout.all_columns
-        if self._row_lines is None:
+        if self._row_spans is None:
             whole, _ = _parse_numbers_or_text(self._data, self._layout, columns, self.text)
             return whole.take(pa.array(rows, pa.int64()))
-        _, starts, ends = self._row_lines
-        data = self._data
+        spans, data = self._row_spans, self._data
         lines = b"".join(
             data[start : end + 1]
-            for start, end in zip(starts[rows].tolist(), ends[rows].tolist(), strict=True)
+            for start, end in zip(spans.start[rows].tolist(), spans.end[rows].tolist(), strict=True)
         )
         table, _ = _parse_numbers_or_text(memoryview(lines), self._layout, columns, self.text)
         return table
+
+
+@dataclass(frozen=True)
+class _Records:
+    """Per CSV record: its first line (index in the chunk), and the byte offsets of the start
+    of that line and of the line end that closes the record."""
+
+    first_line: NDArray[np.int64]
+    start: NDArray[np.int64]
+    end: NDArray[np.int64]
+
+
+def _records(data: memoryview, line_ends: NDArray[np.int64], count: int) -> _Records | None:
+    """Where the chunk's ``count`` records (valid or malformed, blank lines aside) lie.
+
+    A record is one non-empty line, unless a quoted field holds a line end, which pyarrow
+    accepts: then the records are followed as Python's ``csv`` module reads them (the same
+    dialect), which is slow but only for such chunks. None if that still gives another count.
+    """
+    starts, ends, non_empty = _lines(data, line_ends)
+    if len(non_empty) == count:
+        return _Records(non_empty, starts[non_empty], ends[non_empty])
+    reader = csv.reader(io.StringIO(codecs.decode(bytes(data), "utf-8"), newline=""))
+    first: list[int] = []
+    last: list[int] = []
+    consumed = 0
+    for record in reader:
+        if record:
+            first.append(consumed)
+            last.append(reader.line_num - 1)
+        consumed = reader.line_num
+    if len(first) != count or consumed != len(line_ends):
+        return None
+    first_line, last_line = np.array(first, np.int64), np.array(last, np.int64)
+    return _Records(first_line, starts[first_line], ends[last_line])
 
 
 @dataclass(frozen=True)
@@ -190,9 +228,10 @@ class _Pieces:
 
 
 def _last_line_end(buffer: bytearray, end: int) -> int:
-    """Just past the last line end before ``end`` (0 if none): a newline, else a lone CR."""
+    """Just past the last line end before ``end`` (0 if none): a newline, else a lone CR.
+    A CR in the last byte may be the first half of a CRLF whose LF is not read yet."""
     cut = buffer.rfind(b"\n", 0, end) + 1
-    return cut if cut else buffer.rfind(b"\r", 0, end) + 1
+    return cut if cut else buffer.rfind(b"\r", 0, end - 1) + 1
 
 
 def _first_line_end(buffer: bytearray, end: int) -> int:
@@ -209,9 +248,9 @@ def _next_chunk(pieces: _Pieces, layout: _Layout) -> CsvChunk | None:
         return None
     data, has_carriage_return = piece
     raw = np.frombuffer(data, np.uint8)
-    newline_offsets = _line_ends(raw, has_carriage_return)
+    line_ends = _line_ends(raw, has_carriage_return)
     first_line = pieces.next_line
-    pieces.next_line += len(newline_offsets)
+    pieces.next_line += len(line_ends)
     if raw.max() >= _FIRST_NON_ASCII:
         try:
             codecs.utf_8_decode(data, "strict", True)
@@ -219,15 +258,15 @@ def _next_chunk(pieces: _Pieces, layout: _Layout) -> CsvChunk | None:
             raise NotUtf8 from None
     invalid: list[tuple[int | None, int, int, str]] = []
     rows, text = _parse_numbers_or_text(data, layout, layout.row_columns, False, invalid)
-    # pyarrow numbers a malformed row among the non-empty lines, from 1.
+    # pyarrow numbers a malformed row among the records, from 1.
     malformed = np.array([number - 1 for number, *_ in invalid if number is not None], np.int64)
     invalid_rows = []
     if invalid:
-        non_empty = _lines(data, newline_offsets)[2]
+        records = _records(data, line_ends, rows.num_rows + len(invalid))
         invalid_rows = [
             InvalidRow(
-                first_line + int(non_empty[number - 1])
-                if number is not None and number <= len(non_empty)
+                first_line + int(records.first_line[number - 1])
+                if records is not None and number is not None
                 else first_line,
                 expected,
                 actual,
@@ -235,7 +274,7 @@ def _next_chunk(pieces: _Pieces, layout: _Layout) -> CsvChunk | None:
             )
             for number, expected, actual, text in invalid
         ]
-    return CsvChunk(rows, invalid_rows, data, newline_offsets, first_line, malformed, layout, text)
+    return CsvChunk(rows, invalid_rows, data, line_ends, first_line, malformed, layout, text)
 
 
 def _parse_numbers_or_text(
