@@ -275,3 +275,21 @@ def test_a_bad_row_costs_its_chunk_not_the_file(
     assert invalid == [16]
     assert parses.count(False) == 1  # only the chunk with line 16, on one thread
     assert len(chunks) > 5
+
+
+@pytest.mark.parametrize("blank", [b"\n", b"\r\n\n", b"\r"])
+@pytest.mark.parametrize("chunk_bytes", [1, 600, csv_chunks.CHUNK_BYTES])
+def test_blank_lines_before_the_header(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, blank: bytes, chunk_bytes: int
+) -> None:
+    """The header is the first non-empty line; the blank lines still count as file lines."""
+    path = tmp_path / "blank_first.csv"
+    path.write_bytes(blank + DMA26.read_bytes())
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
+    data = load_ais([path])
+    pd.testing.assert_frame_equal(data.positions, load_ais([DMA26]).positions)
+    assert "unparseable" not in data.ledger.rejects
+    lines_before = blank.replace(b"\r\n", b"\n").replace(b"\r", b"\n").count(b"\n")
+    assert data.ledger.examples["not_a_vessel"] == [
+        f"{path}:{13 + lines_before}: mobile type 'AtoN'"
+    ]

@@ -218,13 +218,28 @@ class _Pieces:
                     end += 1
                 cut = end
             start = 0
-            if self._skip_header and cut:
-                self._skip_header = False
-                start = _first_line_end(buffer, cut)
+            if self._skip_header:
+                start = self._past_blank_lines(buffer, cut)
+                if start < cut:
+                    self._skip_header = False
+                    start = _first_line_end(buffer, start, cut)
             if start < cut:
                 return memoryview(buffer)[start:cut], buffer.find(b"\r", start, cut) != -1
             if not got:
                 return None
+
+    def _past_blank_lines(self, buffer: bytearray, end: int) -> int:
+        """Just past the blank lines before the header, which count as lines of the file."""
+        start = 0
+        while start < end and buffer[start] in (_NEWLINE, _CARRIAGE_RETURN):
+            crlf = (
+                buffer[start] == _CARRIAGE_RETURN
+                and start + 1 < end
+                and (buffer[start + 1] == _NEWLINE)
+            )
+            self.next_line += 0 if crlf else 1
+            start += 1
+        return start
 
 
 def _last_line_end(buffer: bytearray, end: int) -> int:
@@ -234,9 +249,9 @@ def _last_line_end(buffer: bytearray, end: int) -> int:
     return cut if cut else buffer.rfind(b"\r", 0, end - 1) + 1
 
 
-def _first_line_end(buffer: bytearray, end: int) -> int:
-    """Just past the first line (the header), which may end in LF, CRLF or a lone CR."""
-    newline, carriage = buffer.find(b"\n", 0, end), buffer.find(b"\r", 0, end)
+def _first_line_end(buffer: bytearray, start: int, end: int) -> int:
+    """Just past the line from ``start`` (the header), which may end in LF, CRLF or a lone CR."""
+    newline, carriage = buffer.find(b"\n", start, end), buffer.find(b"\r", start, end)
     if carriage != -1 and (newline == -1 or carriage + 1 < newline):
         return carriage + 1
     return newline + 1 if newline != -1 else end
