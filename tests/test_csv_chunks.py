@@ -145,7 +145,7 @@ def test_rows_that_do_not_match_lines_parse_the_chunk_whole(
 ) -> None:
     """The guard for records that match no known layout: the whole chunk, all columns."""
     plain = load_ais([DMA26])
-    monkeypatch.setattr(csv_chunks, "_records", lambda data, line_ends, count: None)
+    monkeypatch.setattr(csv_chunks, "_find_records", lambda data, line_ends, count: None)
     for chunk_bytes in (600, csv_chunks.CHUNK_BYTES):
         monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
         data = load_ais([DMA26])

@@ -66,27 +66,46 @@ class CsvChunk:
     def __init__(
         self,
         rows: pa.Table,
-        invalid_rows: list[InvalidRow],
+        invalid: list[tuple[int | None, int, int, str]],
         data: memoryview,
         line_ends: NDArray[np.int64],
         first_line: int,
-        malformed: NDArray[np.int64],
         layout: _Layout,
         text: bool,
     ) -> None:
         self.rows = rows
-        self.invalid_rows = invalid_rows
         self.text = text
+        self._invalid = invalid  # (record number from 1, expected, actual fields, text)
+        self._malformed = np.array([n - 1 for n, *_ in invalid if n is not None], np.int64)
         self._data = data
         self._line_ends = line_ends
         self._first_line = first_line
-        self._malformed = malformed  # their indices among the records
         self._layout = layout
+
+    @functools.cached_property
+    def _records(self) -> _Records | None:
+        return _find_records(self._data, self._line_ends, self.rows.num_rows + len(self._invalid))
+
+    @functools.cached_property
+    def invalid_rows(self) -> list[InvalidRow]:
+        """The malformed rows, skipped, with the file line each starts on."""
+        records = self._records if self._invalid else None
+        return [
+            InvalidRow(
+                self._first_line + int(records.first_line[number - 1])
+                if records is not None and number is not None
+                else self._first_line,
+                expected,
+                actual,
+                line_text,
+            )
+            for number, expected, actual, line_text in self._invalid
+        ]
 
     @functools.cached_property
     def _row_spans(self) -> _Records | None:
         """Where each row lies in the chunk; None if the records do not match the rows."""
-        records = _records(self._data, self._line_ends, self.rows.num_rows + len(self._malformed))
+        records = self._records
         if records is None:
             return None
         keep = np.delete(np.arange(len(records.first_line)), self._malformed)
@@ -123,7 +142,7 @@ class _Records:
     end: NDArray[np.int64]
 
 
-def _records(data: memoryview, line_ends: NDArray[np.int64], count: int) -> _Records | None:
+def _find_records(data: memoryview, line_ends: NDArray[np.int64], count: int) -> _Records | None:
     """Where the chunk's ``count`` records (valid or malformed, blank lines aside) lie.
 
     A record is one non-empty line, unless a quoted field holds a line end, which pyarrow
@@ -273,23 +292,7 @@ def _next_chunk(pieces: _Pieces, layout: _Layout) -> CsvChunk | None:
             raise NotUtf8 from None
     invalid: list[tuple[int | None, int, int, str]] = []
     rows, text = _parse_numbers_or_text(data, layout, layout.row_columns, False, invalid)
-    # pyarrow numbers a malformed row among the records, from 1.
-    malformed = np.array([number - 1 for number, *_ in invalid if number is not None], np.int64)
-    invalid_rows = []
-    if invalid:
-        records = _records(data, line_ends, rows.num_rows + len(invalid))
-        invalid_rows = [
-            InvalidRow(
-                first_line + int(records.first_line[number - 1])
-                if records is not None and number is not None
-                else first_line,
-                expected,
-                actual,
-                text,
-            )
-            for number, expected, actual, text in invalid
-        ]
-    return CsvChunk(rows, invalid_rows, data, line_ends, first_line, malformed, layout, text)
+    return CsvChunk(rows, invalid, data, line_ends, first_line, layout, text)
 
 
 def _parse_numbers_or_text(
