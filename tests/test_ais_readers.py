@@ -12,6 +12,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from colregs9_cli.ais import csv_chunks
 from colregs9_cli.ais.clean import nav_status_code
 from colregs9_cli.ais.load import load_ais
 from colregs9_cli.errors import InputFileError, ParameterError
@@ -152,8 +153,13 @@ def test_nmea_through_limfjorden_query() -> None:
     assert set(data.dimension_reports["mmsi"]) <= set(data.positions["mmsi"])
 
 
+@pytest.mark.parametrize("chunk_bytes", [333, csv_chunks.CHUNK_BYTES])
 @pytest.mark.parametrize("kind", ["gz", "zip"])
-def test_compressed_variants_read_the_same(tmp_path: Path, kind: str) -> None:
+def test_compressed_variants_read_the_same(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, kind: str, chunk_bytes: int
+) -> None:
+    """Also in chunks of a few lines: decompressing readers return short reads."""
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
     if kind == "gz":
         path = tmp_path / "aisdk.csv.gz"
         path.write_bytes(gzip.compress(DMA22.read_bytes()))

@@ -6,8 +6,6 @@ fixture, whose counts tests/test_ais_readers.py checks independently.
 
 from __future__ import annotations
 
-import gzip
-import zipfile
 from pathlib import Path
 
 import pandas as pd
@@ -76,23 +74,6 @@ def test_chunk_size_never_changes_the_result(
     whole = load_ais([DMA26])
     monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
     _same(load_ais([DMA26]), whole)
-
-
-@pytest.mark.parametrize("kind", ["gz", "zip"])
-def test_compressed_streams_in_small_chunks(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, kind: str
-) -> None:
-    """Decompressing readers return short reads; the chunks still hold whole lines."""
-    if kind == "gz":
-        path = tmp_path / "ais.csv.gz"
-        path.write_bytes(gzip.compress(DMA26.read_bytes()))
-    else:
-        path = tmp_path / "ais.zip"
-        with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
-            archive.write(DMA26, "aisdk.csv")
-    whole = load_ais([DMA26])
-    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", 333)
-    _same(load_ais([path]), whole)
 
 
 def test_rows_cut_out_of_a_chunk_are_the_right_rows(
