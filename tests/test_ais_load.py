@@ -73,6 +73,19 @@ def test_static_report_outside_query_still_counts_for_dimensions(tmp_path: Path)
     assert reports == {25.0: 2, 30.0: 1}
 
 
+def test_duplicate_rows_do_not_count_as_dimension_reports(tmp_path: Path) -> None:
+    """A row sent three times is one report; a second file repeating it adds none."""
+    lines = DMA26.read_text().splitlines()
+    row = next(line for line in lines if ",209183000," in line)  # COPERNICUS, with dimensions
+    first, second = tmp_path / "a.csv", tmp_path / "b.csv"
+    first.write_text("\n".join([HEADER, row, row, row]) + "\n")
+    second.write_text("\n".join([HEADER, row]) + "\n")
+    data = load_ais([first, second])
+    assert data.ledger.rejects["duplicate"] == 3
+    assert data.dimension_reports["n_reports"].tolist() == [1]
+    assert data.dimension_reports["mmsi"].tolist() == [209183000]
+
+
 # -- the ledger always balances ----------------------------------------------------------------
 
 MOBILE = st.sampled_from(["Class A", "Class B", "Base Station", "AtoN", "SAR Airborne"])

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from colregs9_cli.ais import csv_chunks
+from colregs9_cli.ais import csv_chunks, dma
 from colregs9_cli.ais.load import AisData, load_ais
 from colregs9_cli.errors import InputFileError
 from colregs9_cli.query import load_query
@@ -213,8 +213,6 @@ def test_text_in_a_column_converted_only_for_kept_rows(tmp_path: Path) -> None:
 
 
 def _chunks_of(path: Path) -> list[csv_chunks.CsvChunk]:
-    from colregs9_cli.ais import dma
-
     names = path.read_text().splitlines()[0].lower().lstrip("# ").split(",")
     with path.open("rb") as stream:
         return list(

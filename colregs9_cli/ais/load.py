@@ -180,30 +180,39 @@ class _FileResult:
     def add_dimensions(self, mmsi: np.ndarray, fields: Fields, rows: np.ndarray) -> None:
         if not rows.any():
             return
-        # Arrow's hash grouping, about twice as fast as pandas'; on this thread, as the
-        # CSV reader keeps pyarrow's thread pool busy.
-        table = pa.table(
-            {
-                "mmsi": mmsi[rows],
-                "length_m": pa.array(fields.length_m[rows], from_pandas=True),
-                "breadth_m": pa.array(fields.breadth_m[rows], from_pandas=True),
-                "draught_m": pa.array(fields.draught_m[rows], from_pandas=True),
-            }
-        )
-        counts = table.group_by(["mmsi", *DIMENSIONS], use_threads=False).aggregate(
-            [([], "count_all")]
-        )
         self.dimension_parts.append(
-            counts.select(["mmsi", *DIMENSIONS, "count_all"]).rename_columns(
-                DIMENSION_REPORT_COLUMNS
+            _count_combinations(
+                mmsi[rows], fields.length_m[rows], fields.breadth_m[rows], fields.draught_m[rows]
             )
         )
         if len(self.dimension_parts) >= _DIMENSION_PARTS_BEFORE_MERGE:
             self.dimension_parts = [_sum_counts(self.dimension_parts)]
 
 
+def _count_combinations(
+    mmsi: np.ndarray, length_m: np.ndarray, breadth_m: np.ndarray, draught_m: np.ndarray
+) -> pa.Table:
+    """How often each (mmsi, length, breadth, draught) occurs; NaN dimensions group as null.
+
+    Arrow's hash grouping, about twice as fast as pandas'; on the calling thread, as the CSV
+    reader keeps pyarrow's thread pool busy.
+    """
+    table = pa.table(
+        {
+            "mmsi": pa.array(mmsi, pa.int64()),
+            "length_m": pa.array(length_m, pa.float64(), from_pandas=True),
+            "breadth_m": pa.array(breadth_m, pa.float64(), from_pandas=True),
+            "draught_m": pa.array(draught_m, pa.float64(), from_pandas=True),
+        }
+    )
+    counts = table.group_by(["mmsi", *DIMENSIONS], use_threads=False).aggregate([([], "count_all")])
+    return counts.select(["mmsi", *DIMENSIONS, "count_all"]).rename_columns(
+        DIMENSION_REPORT_COLUMNS
+    )
+
+
 def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
-    """Per-block counts of (mmsi, dimensions) combined into one count per combination."""
+    """Counts of (mmsi, dimensions) from several parts combined into one per combination."""
     summed = (
         pa.concat_tables(parts)
         .group_by(["mmsi", *DIMENSIONS], use_threads=False)
@@ -212,17 +221,6 @@ def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
     return summed.select(["mmsi", *DIMENSIONS, "n_reports_sum"]).rename_columns(
         DIMENSION_REPORT_COLUMNS
     )
-
-
-def _count_combinations(frame: pd.DataFrame) -> pd.DataFrame:
-    counts = frame.groupby(["mmsi", *DIMENSIONS], dropna=False, sort=False).size()
-    return counts.rename("n_reports").reset_index()
-
-
-def _merge_counts(parts: Sequence[pd.DataFrame]) -> pd.DataFrame:
-    merged = pd.concat(parts, ignore_index=True)
-    summed = merged.groupby(["mmsi", *DIMENSIONS], dropna=False, sort=False)["n_reports"].sum()
-    return summed.reset_index()
 
 
 def _read_source(source: Source, fmt: str | None, query: Query, bar: ProgressSink) -> _FileResult:
@@ -662,10 +660,9 @@ class _Collected:
         positions = _to_pandas(table)
         positions = positions.sort_values(["mmsi", "timestamp"], kind="stable", ignore_index=True)
         duplicate = positions.duplicated(keep="first").to_numpy()
-        counts = (
-            _sum_counts(self.dimension_parts).to_pandas()
-            if self.dimension_parts
-            else _empty_counts()
+        empty = np.empty(0)
+        counts = _sum_counts(
+            [_count_combinations(empty, empty, empty, empty), *self.dimension_parts]
         )
         if duplicate.any():
             dropped = positions.loc[duplicate]
@@ -679,30 +676,23 @@ class _Collected:
             positions = positions.loc[~duplicate].reset_index(drop=True)
         ledger.use(len(positions))
         vessels = np.unique(positions["mmsi"].to_numpy())
-        reports = counts[counts["mmsi"].isin(vessels) & (counts["n_reports"] > 0)]
+        frame = counts.to_pandas()
+        reports = frame[frame["mmsi"].isin(vessels) & (frame["n_reports"] > 0)]
         reports = reports.sort_values(["mmsi", *DIMENSIONS], ignore_index=True)
         reports["n_reports"] = reports["n_reports"].astype(np.int64)
         return positions, reports[list(DIMENSION_REPORT_COLUMNS)]
 
 
-def _empty_counts() -> pd.DataFrame:
-    return pd.DataFrame(
-        {
-            "mmsi": np.array([], dtype=np.int64),
-            **{d: np.array([], dtype=np.float64) for d in DIMENSIONS},
-            "n_reports": np.array([], dtype=np.int64),
-        }
-    )
-
-
-def _subtract_counts(counts: pd.DataFrame, dropped: pd.DataFrame) -> pd.DataFrame:
+def _subtract_counts(counts: pa.Table, dropped: pd.DataFrame) -> pa.Table:
     frame = dropped[["mmsi", *DIMENSIONS]].astype({d: np.float64 for d in DIMENSIONS})
     frame = frame[frame[list(DIMENSIONS)].notna().any(axis=1)]
     if frame.empty:
         return counts
-    removed = _count_combinations(frame)
-    removed["n_reports"] = -removed["n_reports"]
-    return _merge_counts([counts, removed])
+    removed = _count_combinations(*(frame[c].to_numpy() for c in ["mmsi", *DIMENSIONS]))
+    negated = removed.set_column(
+        len(DIMENSION_REPORT_COLUMNS) - 1, "n_reports", pc.negate(removed.column("n_reports"))
+    )
+    return _sum_counts([counts, negated])
 
 
 def _to_pandas(table: pa.Table) -> pd.DataFrame:
