@@ -128,3 +128,17 @@ def test_ledger_balances_on_generated_dma(tmp_path: Path, rows: list[str], boxed
     assert not data.positions.duplicated().any()
     assert data.positions["mmsi"].between(201_000_000, 775_999_999).all()
     assert pd.Series(data.positions["mobile_type"]).isin(["Class A", "Class B"]).all()
+
+
+def test_dimensions_written_two_ways_are_one_report(tmp_path: Path) -> None:
+    """The tanker's 288 m once as A+B (223+65) and once as the Length column only: the
+    two rows differ as read but clean to the same report, counted twice."""
+    lines = DMA26.read_text().splitlines()
+    with_abcd = lines[1]
+    without = with_abcd.replace("00:00:33", "00:01:33").replace(",223,65,25,24", ",,,,")
+    path = tmp_path / "two_ways.csv"
+    path.write_text("\n".join([lines[0], with_abcd, without]) + "\n")
+    reports = load_ais([path]).dimension_reports
+    assert reports.to_dict("records") == [
+        {"mmsi": 257739000, "length_m": 288.0, "breadth_m": 49.0, "draught_m": 11.4, "n_reports": 2}
+    ]

@@ -317,3 +317,28 @@ def test_multiple_files_dedupe_across_files(tmp_path: Path) -> None:
     assert data.rows_in_query == 15
     assert data.ledger.rejects["duplicate"] == 2 + 15
     assert [f.rows_read for f in data.inputs] == [20, 20]
+
+
+@pytest.mark.parametrize("spelling", ["NULL", "N/A", "NaN", "na", " null "])
+def test_null_spellings_in_number_columns_are_not_available(tmp_path: Path, spelling: str) -> None:
+    """pyarrow's null spellings in a number column mean "not available", not bad text."""
+    lines = DMA26.read_text().splitlines()
+    lines[1] = lines[1].replace(",GPS,11.4,", f",GPS,{spelling},")  # the tanker's draught
+    lines[4] = lines[4].replace("54.702822", spelling)  # 244130689: nothing static either
+    path = tmp_path / "nulls.csv"
+    path.write_text("\n".join(lines) + "\n")
+    data = load_ais([path])
+    assert dict(data.ledger.rejects) == {
+        "not_a_vessel": 1,
+        "duplicate": 1,
+        "position_not_available": 1,
+    }
+    assert math.isnan(row_of(data, 257739000)["draught_m"])
+    assert 244130689 not in set(data.positions["mmsi"])
+
+
+def test_an_mmsi_written_as_a_decimal_reads_the_same(tmp_path: Path) -> None:
+    """MMSIs are read as integers; a chunk with "257739000.0" is read as text instead."""
+    path = tmp_path / "decimal.csv"
+    path.write_text(DMA26.read_text().replace(",257739000,", ",257739000.0,"))
+    pd.testing.assert_frame_equal(load_ais([path]).positions, load_ais([DMA26]).positions)

@@ -10,6 +10,7 @@ text columns.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,6 +29,10 @@ MAX_ROT_DEG_PER_MIN = 720.0
 _NUMBER = r"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*$"
 _NULL_TEXTS = ["", "unknown", "undefined", "unknown value", "not available", "n/a"]
 NULL_TEXTS = frozenset(_NULL_TEXTS)
+# Null in a number column: empty, or one of pyarrow's default null spellings (lower case),
+# which the CSV parse leaves to ``to_float`` (see csv_chunks.py).
+_NUMBER_NULL_TEXTS = ["", "#n/a", "#n/a n/a", "#na", "-1.#ind", "-1.#qnan", "-nan", "1.#ind"]
+_NUMBER_NULL_TEXTS += ["1.#qnan", "n/a", "na", "nan", "null"]
 
 # Navigational status text (DMA and others) -> ITU-R M.1371 code, matched after lower-casing
 # and dropping everything but letters. Unrecognised text maps to null.
@@ -127,7 +132,8 @@ def to_float(values: pa.Array | pa.ChunkedArray) -> tuple[pa.Array, BoolArray]:
     """A column as float64, and where it held text that is not a number.
 
     Columns read as numbers pass through. Text is cast directly when it all parses, else
-    entry by entry: non-numeric text becomes null and is flagged, empty text is just null.
+    entry by entry: non-numeric text becomes null and is flagged; empty text, ``NULL``,
+    ``N/A``, ``NaN`` and the like are just null.
     """
     if isinstance(values, pa.ChunkedArray):
         values = values.combine_chunks()
@@ -136,8 +142,10 @@ def to_float(values: pa.Array | pa.ChunkedArray) -> tuple[pa.Array, BoolArray]:
         return values.cast(pa.float64()), np.zeros(n, dtype=bool)
     if pa.types.is_null(values.type):
         return pa.nulls(n, pa.float64()), np.zeros(n, dtype=bool)
-    blank = pc.equal(pc.utf8_trim_whitespace(values), "")
-    present = pc.and_(pc.invert(blank), pc.is_valid(values))
+    absent = pc.is_in(
+        pc.utf8_lower(pc.utf8_trim_whitespace(values)), value_set=pa.array(_NUMBER_NULL_TEXTS)
+    )
+    present = pc.and_(pc.invert(absent), pc.is_valid(values))
     cleaned = pc.if_else(present, values, pa.scalar(None, pa.string()))
     try:
         return pc.cast(cleaned, pa.float64()), np.zeros(n, dtype=bool)
@@ -148,7 +156,7 @@ def to_float(values: pa.Array | pa.ChunkedArray) -> tuple[pa.Array, BoolArray]:
         return pc.cast(usable, pa.float64()), bad.to_numpy(zero_copy_only=False)
 
 
-def to_numpy_float(values: pa.Array) -> FloatArray:
+def to_numpy_float(values: pa.Array | pa.ChunkedArray) -> FloatArray:
     """Nulls as NaN (filling first is about twice as fast as letting to_numpy do it)."""
     if values.null_count:
         values = pc.fill_null(values, pa.scalar(np.nan, pa.float64()))
@@ -156,6 +164,8 @@ def to_numpy_float(values: pa.Array) -> FloatArray:
 
 
 def float_column(values: pa.Array | pa.ChunkedArray) -> tuple[FloatArray, BoolArray]:
+    if pa.types.is_floating(values.type) or pa.types.is_integer(values.type):
+        return to_numpy_float(values.cast(pa.float64())), np.zeros(len(values), dtype=bool)
     array, bad = to_float(values)
     return to_numpy_float(array), bad
 
@@ -216,23 +226,44 @@ def is_vessel(mobile_type: pa.Array) -> BoolArray:
     return np.asarray(pc.fill_null(mask, False).to_numpy(zero_copy_only=False), dtype=bool)
 
 
+Dimensions = tuple[FloatArray, FloatArray, FloatArray]
+
+
+@dataclass(frozen=True)
+class DimensionColumns:
+    """A block's dimension columns as read, one row per row, and ``clean``, which turns
+    such columns into length, breadth and draught in metres (NaN = not available).
+
+    Cleaning is left until it is needed: a vessel repeats its dimensions in row after row,
+    so the pipeline counts the distinct rows as read and cleans only those.
+    """
+
+    table: pa.Table
+    clean: Callable[[pa.Table], Dimensions]
+
+    def of_rows(self, rows: NDArray[np.int64]) -> Dimensions:
+        return self.clean(self.table.take(pa.array(rows, pa.int64())))
+
+
+def any_dimension(length_m: FloatArray, breadth_m: FloatArray, draught_m: FloatArray) -> BoolArray:
+    return ~(np.isnan(length_m) & np.isnan(breadth_m) & np.isnan(draught_m))
+
+
 @dataclass
 class Fields:
     """What the pipeline needs of every row of a block before choosing the rows to keep.
 
     ``mmsi`` is -1 where missing or not a number. ``unparseable`` marks rows with text
     where a number belongs (in MMSI, latitude or longitude), with ``problem`` saying what
-    for the ledger's examples (empty when no row is unparseable). Positions and dimensions
-    are cleaned (NaN = not available).
+    for the ledger's examples (empty when no row is unparseable). Positions are cleaned
+    (NaN = not available); dimensions are as read, with their cleaning.
     """
 
     mmsi: NDArray[np.int64]
     lat_deg: FloatArray
     lon_deg: FloatArray
     vessel: BoolArray
-    length_m: FloatArray
-    breadth_m: FloatArray
-    draught_m: FloatArray
+    dimensions: DimensionColumns
     unparseable: BoolArray
     problem: list[str]
 
@@ -242,6 +273,9 @@ class Fields:
 
 def mmsi_column(values: pa.Array | pa.ChunkedArray) -> tuple[NDArray[np.int64], BoolArray]:
     """MMSIs as int64 (-1 where missing or not an integer), and where the text was not a number."""
+    if pa.types.is_integer(values.type):
+        filled = pc.fill_null(values, -1).to_numpy()
+        return np.asarray(filled, dtype=np.int64), np.zeros(len(values), dtype=bool)
     floats, bad = float_column(values)
     whole = np.isfinite(floats) & (np.floor(floats) == floats)
     bad = bad | (np.isfinite(floats) & ~whole)

@@ -21,9 +21,12 @@ Each chunk falls back on its own, so a bad row costs one chunk, not the file:
 - Malformed rows (a wrong number of fields) are skipped and reported with their file line.
   Parsing on several threads loses line numbers, so a chunk with one is parsed again on one
   thread.
-- The ``numeric`` columns are read as numbers. A chunk where one holds text (``north`` for a
-  latitude) is parsed again with every column as text, and the caller's cleaning sorts the
-  values out (``CsvChunk.text`` tells). The same holds for the rows cut out by ``take``.
+- The ``numeric`` columns are read as numbers (the ``whole`` ones as integers, which only
+  the MMSI is). A chunk where one holds something else (``north`` for a latitude, ``N/A``, a
+  decimal MMSI) is parsed again with every column as text, and the caller's cleaning sorts
+  the values out (``CsvChunk.text`` tells). The same holds for the rows cut out by ``take``.
+  Only an empty field is null: pyarrow's other null spellings (``NULL``, ``NA``, ...) cost
+  every number a lookup, and the text path turns them to null.
 """
 
 from __future__ import annotations
@@ -68,17 +71,18 @@ class CsvChunk:
         rows: pa.Table,
         invalid: list[tuple[int | None, int, int, str]],
         data: memoryview,
-        line_ends: NDArray[np.int64],
+        has_carriage_return: bool,
+        text: bool,
         first_line: int,
         layout: _Layout,
-        text: bool,
     ) -> None:
         self.rows = rows
         self.text = text
         self._invalid = invalid  # (record number from 1, expected, actual fields, text)
         self._malformed = np.array([n - 1 for n, *_ in invalid if n is not None], np.int64)
         self._data = data
-        self._line_ends = line_ends
+        self._line_ends = _line_ends(np.frombuffer(data, np.uint8), has_carriage_return)
+        self.line_count = len(self._line_ends)
         self._first_line = first_line
         self._layout = layout
 
@@ -108,6 +112,8 @@ class CsvChunk:
         records = self._records
         if records is None:
             return None
+        if not len(self._malformed):
+            return records
         keep = np.delete(np.arange(len(records.first_line)), self._malformed)
         return _Records(records.first_line[keep], records.start[keep], records.end[keep])
 
@@ -117,19 +123,29 @@ class CsvChunk:
             return self._first_line
         return self._first_line + int(self._row_spans.first_line[row])
 
-    def take(self, rows: NDArray[np.int64]) -> pa.Table:
-        """All columns of the given rows (indices into ``rows``), in that order."""
-        columns = self._layout.all_columns
+    def take(self, rows: NDArray[np.int64], columns: Sequence[str] | None = None) -> pa.Table:
+        """The given rows (indices into ``rows``), in that order, with ``columns`` (by
+        default all) converted."""
+        columns = self._layout.all_columns if columns is None else columns
         if self._row_spans is None:
             whole, _ = _parse_numbers_or_text(self._data, self._layout, columns, self.text)
             return whole.take(pa.array(rows, pa.int64()))
-        spans, data = self._row_spans, self._data
-        lines = b"".join(
-            data[start : end + 1]
-            for start, end in zip(spans.start[rows].tolist(), spans.end[rows].tolist(), strict=True)
-        )
-        table, _ = _parse_numbers_or_text(memoryview(lines), self._layout, columns, self.text)
+        spans = self._row_spans
+        lines = _gather(self._data, spans.start[rows], spans.end[rows] + 1)
+        # On this thread: in pyarrow's pool these few rows would queue behind the next chunk.
+        table, _ = _parse_numbers_or_text(lines, self._layout, columns, self.text, threads=False)
         return table
+
+
+def _gather(data: memoryview, starts: NDArray[np.int64], stops: NDArray[np.int64]) -> memoryview:
+    """The byte ranges ``[start, stop)`` of ``data`` one after another."""
+    lengths = stops - starts
+    # The index of every byte to copy: each range's first byte, then steps of one.
+    steps = np.ones(int(lengths.sum()), np.int64)
+    firsts = np.cumsum(lengths[:-1])
+    steps[0:1] = starts[:1]
+    steps[firsts] = starts[1:] - stops[:-1] + 1
+    return memoryview(np.frombuffer(data, np.uint8)[np.cumsum(steps)].tobytes())
 
 
 @dataclass(frozen=True)
@@ -149,6 +165,11 @@ def _find_records(data: memoryview, line_ends: NDArray[np.int64], count: int) ->
     accepts: then the records are followed as Python's ``csv`` module reads them (the same
     dialect), which is slow but only for such chunks. None if that still gives another count.
     """
+    if len(line_ends) == count:  # each record one line: no blank line, no quoted line end
+        starts = np.empty_like(line_ends)
+        starts[:1] = 0
+        starts[1:] = line_ends[:-1] + 1
+        return _Records(np.arange(count), starts, line_ends)
     starts, ends, non_empty = _lines(data, line_ends)
     if len(non_empty) == count:
         return _Records(non_empty, starts[non_empty], ends[non_empty])
@@ -173,6 +194,7 @@ class _Layout:
     row_columns: Sequence[str]
     all_columns: Sequence[str]
     numeric: frozenset[str]
+    whole: frozenset[str]
 
 
 def read_chunks(
@@ -182,39 +204,46 @@ def read_chunks(
     row_columns: Sequence[str],
     all_columns: Sequence[str],
     numeric: Sequence[str],
+    whole: Sequence[str] = (),
 ) -> Generator[CsvChunk, None, None]:
     """The chunks of a CSV stream, each parsed (on a worker thread) while the last is used.
 
     ``names`` are the file's columns; ``row_columns`` are converted for every row,
     ``all_columns`` for the rows taken; ``numeric`` columns are read as numbers where they
-    can be. Raises ``pa.ArrowInvalid`` for data pyarrow cannot read, ``NotUtf8``, and
-    whatever reading the stream raises.
+    can be, those also in ``whole`` as integers. Raises ``pa.ArrowInvalid`` for data
+    pyarrow cannot read, ``NotUtf8``, and whatever reading the stream raises.
     """
-    layout = _Layout(names, row_columns, all_columns, frozenset(numeric))
+    layout = _Layout(names, row_columns, all_columns, frozenset(numeric), frozenset(whole))
     pieces = _Pieces(stream, first_line=2 if has_header else 1, skip_header=has_header)
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="colregs9-csv") as pool:
 
-        def submit() -> Future[CsvChunk | None]:
+        def submit() -> Future[_Parsed | None]:
             return pool.submit(_next_chunk, pieces, layout)
 
         pending = submit()
+        line = 0
         try:
-            while (chunk := pending.result()) is not None:
+            while (parsed := pending.result()) is not None:
+                line = line or pieces.first_line  # known once the first piece is read
                 pending = submit()
+                # The line ends are found here rather than on the worker: numpy holds the
+                # GIL for them, which would stall this thread's work on the last chunk.
+                chunk = CsvChunk(*parsed, first_line=line, layout=layout)
+                line += chunk.line_count
                 yield chunk
         finally:
             pending.cancel()
 
 
 class _Pieces:
-    """Whole-line pieces of a stream, each in its own buffer, and the file line the next
-    one starts on. Used by the worker thread only."""
+    """Whole-line pieces of a stream, each in its own buffer, and the file line the first
+    one starts on (set by the read that finds the header). Used by the worker thread."""
 
     def __init__(self, stream: BinaryIO, first_line: int, skip_header: bool) -> None:
         self._stream = stream
         self._carry = b""
         self._skip_header = skip_header
-        self.next_line = first_line
+        self.first_line = first_line
 
     def read(self) -> tuple[memoryview, bool] | None:
         """The next piece, and whether it holds a carriage return."""
@@ -256,7 +285,7 @@ class _Pieces:
                 and start + 1 < end
                 and (buffer[start + 1] == _NEWLINE)
             )
-            self.next_line += 0 if crlf else 1
+            self.first_line += 0 if crlf else 1
             start += 1
         return start
 
@@ -276,23 +305,24 @@ def _first_line_end(buffer: bytearray, start: int, end: int) -> int:
     return newline + 1 if newline != -1 else end
 
 
-def _next_chunk(pieces: _Pieces, layout: _Layout) -> CsvChunk | None:
+_Parsed = tuple[pa.Table, list[tuple[int | None, int, int, str]], memoryview, bool, bool]
+
+
+def _next_chunk(pieces: _Pieces, layout: _Layout) -> _Parsed | None:
+    """The next piece parsed: its rows, malformed rows, bytes, whether it holds a carriage
+    return, and whether it was read as text. None at the end."""
     piece = pieces.read()
     if piece is None:
         return None
     data, has_carriage_return = piece
-    raw = np.frombuffer(data, np.uint8)
-    line_ends = _line_ends(raw, has_carriage_return)
-    first_line = pieces.next_line
-    pieces.next_line += len(line_ends)
-    if raw.max() >= _FIRST_NON_ASCII:
+    if np.frombuffer(data, np.uint8).max() >= _FIRST_NON_ASCII:
         try:
             codecs.utf_8_decode(data, "strict", True)
         except UnicodeDecodeError:
             raise NotUtf8 from None
     invalid: list[tuple[int | None, int, int, str]] = []
     rows, text = _parse_numbers_or_text(data, layout, layout.row_columns, False, invalid)
-    return CsvChunk(rows, invalid, data, line_ends, first_line, layout, text)
+    return rows, invalid, data, has_carriage_return, text
 
 
 def _parse_numbers_or_text(
@@ -301,12 +331,13 @@ def _parse_numbers_or_text(
     columns: Sequence[str],
     text: bool,
     invalid: list[tuple[int | None, int, int, str]] | None = None,
+    threads: bool = True,
 ) -> tuple[pa.Table, bool]:
-    """Parse on all cores with numbers as numbers; again on one thread if a row is malformed
-    (for its line number), and again as text if a number column holds text. Returns the
-    table and whether it was read as text. Malformed rows are skipped and go to ``invalid``.
+    """Parse with numbers as numbers, on all cores if ``threads``; again on one thread if a
+    row is malformed (for its line number), and again as text if a number column holds
+    text. Returns the table and whether it was read as text. Malformed rows are skipped
+    and go to ``invalid``.
     """
-    threads = True
     while True:
         found: list[tuple[int | None, int, int, str]] = []
 
@@ -314,9 +345,7 @@ def _parse_numbers_or_text(
             found.append((row.number, row.expected_columns, row.actual_columns, row.text))
             return "error" if threads else "skip"
 
-        types = {
-            c: pa.float64() if c in layout.numeric and not text else pa.string() for c in columns
-        }
+        types = {c: _type(c, layout, text) for c in columns}
         try:
             table = _parse(data, layout.names, types, threads, invalid_row)
         except pa.ArrowInvalid as exc:
@@ -330,6 +359,12 @@ def _parse_numbers_or_text(
         if invalid is not None:
             invalid.extend(found)
         return table, text
+
+
+def _type(column: str, layout: _Layout, text: bool) -> pa.DataType:
+    if text or column not in layout.numeric:
+        return pa.string()
+    return pa.int64() if column in layout.whole else pa.float64()
 
 
 def _line_ends(raw: NDArray[np.uint8], has_carriage_return: bool) -> NDArray[np.int64]:
@@ -373,6 +408,7 @@ def _parse(
         convert_options=pacsv.ConvertOptions(
             column_types=dict(types),
             include_columns=list(types),
+            null_values=[""],
             strings_can_be_null=False,
             quoted_strings_can_be_null=False,
         ),

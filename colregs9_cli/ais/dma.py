@@ -19,6 +19,8 @@ import pyarrow.compute as pc
 
 from .clean import (
     BoolArray,
+    DimensionColumns,
+    Dimensions,
     Fields,
     clean_angle,
     clean_rot,
@@ -89,7 +91,12 @@ def row_columns(has_abcd: bool) -> tuple[str, ...]:
     return (*ROW_COLUMNS, *ABCD) if has_abcd else ROW_COLUMNS
 
 
-def _dimensions(batch: pa.RecordBatch, has_abcd: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def dimension_columns(has_abcd: bool) -> tuple[str, ...]:
+    return ("width", "length", "draught", *ABCD) if has_abcd else ("width", "length", "draught")
+
+
+def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
+    """Length and breadth from A+B and C+D where both are given, else from Length and Width."""
     width, _ = float_column(batch.column("width"))
     length, _ = float_column(batch.column("length"))
     draught, _ = float_column(batch.column("draught"))
@@ -103,16 +110,14 @@ def dma_fields(batch: pa.RecordBatch, has_abcd: bool) -> Fields:
     mmsi, bad_mmsi = mmsi_column(batch.column("mmsi"))
     lat, bad_lat = float_column(batch.column("latitude"))
     lon, bad_lon = float_column(batch.column("longitude"))
-    length, breadth, draught = _dimensions(batch, has_abcd)
     unparseable, problem = number_problems(bad_mmsi, bad_lat, bad_lon)
+    dimensions = batch.select(list(dimension_columns(has_abcd)))
     return Fields(
         mmsi=mmsi,
         lat_deg=null_outside(lat, -90.0, 90.0),
         lon_deg=null_outside(lon, -180.0, 180.0),
         vessel=_is_vessel(batch.column("type of mobile")),
-        length_m=length,
-        breadth_m=breadth,
-        draught_m=draught,
+        dimensions=DimensionColumns(dimensions, lambda table: _dimensions(table, has_abcd)),
         unparseable=unparseable,
         problem=problem,
     )

@@ -58,7 +58,17 @@ from ..progress import ProgressSink, progress_bar, progress_enabled
 from ..query import Query, everything_query
 from . import dma, marinecadastre
 from .batch import AisBatch
-from .clean import Fields, clean_text, is_vessel, null_outside, valid_mmsi
+from .clean import (
+    DimensionColumns,
+    Dimensions,
+    Fields,
+    any_dimension,
+    clean_text,
+    is_vessel,
+    null_outside,
+    to_numpy_float,
+    valid_mmsi,
+)
 from .csv_chunks import CsvChunk, NotUtf8, read_chunks
 from .detect import CSV_LAYOUTS, LAYOUTS, csv_header, detect_layout
 from .ledger import RejectReason, RejectsLedger
@@ -177,22 +187,46 @@ class _FileResult:
     layout: str = ""
     sha256: str = ""
 
-    def add_dimensions(self, mmsi: np.ndarray, fields: Fields, rows: np.ndarray) -> None:
+    def add_dimensions(
+        self, mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray
+    ) -> None:
+        """Count the dimensions reported by ``rows`` (a mask); rows without any are left out."""
         if not rows.any():
             return
-        self.dimension_parts.append(
-            _count_combinations(
-                mmsi[rows], fields.length_m[rows], fields.breadth_m[rows], fields.draught_m[rows]
-            )
-        )
+        self.dimension_parts.append(_count_reports(mmsi, dimensions, rows))
         if len(self.dimension_parts) >= _DIMENSION_PARTS_BEFORE_MERGE:
             self.dimension_parts = [_sum_counts(self.dimension_parts)]
 
 
+def _count_reports(mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray) -> pa.Table:
+    """``_count_combinations`` of the cleaned dimensions of ``rows``, without the rows that
+    report none. The rows are grouped as read first, and only the groups are cleaned."""
+    key = "mmsi"
+    while key in dimensions.table.column_names:
+        key = f"_{key}"
+    keyed = dimensions.table.append_column(key, pa.array(np.where(rows, mmsi, -1), pa.int64()))
+    groups = keyed.group_by(keyed.column_names, use_threads=False).aggregate([([], "count_all")])
+    groups = groups.filter(pc.not_equal(groups.column(key), -1))
+    length_m, breadth_m, draught_m = dimensions.clean(groups)
+    reported = any_dimension(length_m, breadth_m, draught_m)
+    return _count_combinations(
+        groups.column(key).to_numpy()[reported],
+        length_m[reported],
+        breadth_m[reported],
+        draught_m[reported],
+        groups.column("count_all").to_numpy()[reported],
+    )
+
+
 def _count_combinations(
-    mmsi: np.ndarray, length_m: np.ndarray, breadth_m: np.ndarray, draught_m: np.ndarray
+    mmsi: np.ndarray,
+    length_m: np.ndarray,
+    breadth_m: np.ndarray,
+    draught_m: np.ndarray,
+    times: np.ndarray | None = None,
 ) -> pa.Table:
-    """How often each (mmsi, length, breadth, draught) occurs; NaN dimensions group as null.
+    """How often each (mmsi, length, breadth, draught) occurs, each row counting ``times``
+    (default once); NaN dimensions group as null.
 
     Arrow's hash grouping, about twice as fast as pandas'; on the calling thread, as the CSV
     reader keeps pyarrow's thread pool busy.
@@ -203,12 +237,10 @@ def _count_combinations(
             "length_m": pa.array(length_m, pa.float64(), from_pandas=True),
             "breadth_m": pa.array(breadth_m, pa.float64(), from_pandas=True),
             "draught_m": pa.array(draught_m, pa.float64(), from_pandas=True),
+            "n_reports": pa.array(np.ones(len(mmsi)) if times is None else times, pa.int64()),
         }
     )
-    counts = table.group_by(["mmsi", *DIMENSIONS], use_threads=False).aggregate([([], "count_all")])
-    return counts.select(["mmsi", *DIMENSIONS, "count_all"]).rename_columns(
-        DIMENSION_REPORT_COLUMNS
-    )
+    return _sum_counts([table])
 
 
 def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
@@ -239,7 +271,7 @@ class _CsvLayout:
     row_columns: tuple[str, ...]  # what ``fields`` reads: converted for every row
     numeric: tuple[str, ...]
     fields: Callable[[pa.RecordBatch], Fields]
-    static_text: Callable[[pa.RecordBatch], np.ndarray]
+    static_text: _StaticText
     canonical: Callable[[pa.RecordBatch], tuple[pa.Table, np.ndarray]]
     example_columns: dict[str, str]  # what -> the column to quote in reject examples
 
@@ -252,7 +284,7 @@ def _csv_layout(layout: str) -> _CsvLayout:
             row_columns=dma.row_columns(abcd),
             numeric=tuple(c for c in dma.NUMERIC_COLUMNS if abcd or c not in dma.ABCD),
             fields=lambda b: dma.dma_fields(b, abcd),
-            static_text=dma.dma_static_text,
+            static_text=_StaticText(dma.STATIC_TEXT_COLUMNS, dma.dma_static_text),
             canonical=lambda b: dma.dma_canonical(b, abcd),
             example_columns={
                 "MMSI": "mmsi",
@@ -267,7 +299,9 @@ def _csv_layout(layout: str) -> _CsvLayout:
         row_columns=marinecadastre.ROW_COLUMNS,
         numeric=marinecadastre.NUMERIC_COLUMNS,
         fields=marinecadastre.marinecadastre_fields,
-        static_text=marinecadastre.marinecadastre_static_text,
+        static_text=_StaticText(
+            marinecadastre.STATIC_COLUMNS, marinecadastre.marinecadastre_static_text
+        ),
         canonical=marinecadastre.marinecadastre_canonical,
         example_columns={
             "MMSI": "mmsi",
@@ -303,6 +337,7 @@ def _read_csv(
             row_columns=spec.row_columns,
             all_columns=spec.columns,
             numeric=spec.numeric,
+            whole=("mmsi",),  # both layouts name it so; a decimal MMSI makes the chunk text
         )
         try:
             with contextlib.closing(chunks):
@@ -349,7 +384,7 @@ def _csv_chunk(result: _FileResult, spec: _CsvLayout, chunk: CsvChunk) -> None:
         if column in rows.column_names:
             value = rows.column(column)[row].as_py()
         else:
-            value = chunk.take(np.array([row])).column(column)[0].as_py()
+            value = chunk.take(np.array([row]), [column]).column(column)[0].as_py()
         if isinstance(value, float) and value.is_integer():
             value = int(value)
         return f"{result.name}:{chunk.line_of(row)}: {why} {value!r}"
@@ -367,17 +402,31 @@ def _csv_chunk(result: _FileResult, spec: _CsvLayout, chunk: CsvChunk) -> None:
 Example = Callable[[int, str, str], str]
 
 
+@dataclass(frozen=True)
+class _StaticText:
+    """Tells the rows without a position that carry static text (a static report) from
+    those that carry nothing, by reading ``columns``."""
+
+    columns: tuple[str, ...]
+    present: Callable[[pa.Table], np.ndarray]
+
+
+Take = Callable[[np.ndarray, Sequence[str] | None], pa.Table]
+
+
 def _classify(
     result: _FileResult,
     fields: Fields,
-    take: Callable[[np.ndarray], pa.Table],
-    static_text: Callable[[Any], np.ndarray] | None,
+    take: Take,
+    static_text: _StaticText | None,
     canonical: Callable[[Any], tuple[pa.Table, np.ndarray]],
     example: Example,
 ) -> None:
     """Account every row of one block (see the module docstring) and keep the query's rows.
 
-    ``take(rows)`` gives every column of those rows of the block.
+    ``take(rows, columns)`` gives those rows of the block with ``columns`` (None: all).
+    ``static_text`` None: a row without a position is never a static report (NMEA
+    position messages).
     """
     ledger = result.ledger
     query = result.query
@@ -403,16 +452,14 @@ def _classify(
     reject(bad_mmsi, RejectReason.INVALID_MMSI, "MMSI", "MMSI")
     left &= ~bad_mmsi
 
-    has_dimension = ~(
-        np.isnan(fields.length_m) & np.isnan(fields.breadth_m) & np.isnan(fields.draught_m)
-    )
     no_position = left & (np.isnan(fields.lat_deg) | np.isnan(fields.lon_deg))
-    static_report = no_position & has_dimension
+    static_report = np.zeros(len(fields), dtype=bool)
     if static_text is not None and no_position.any():
         rows = np.flatnonzero(no_position)
-        static_report[rows] |= static_text(take(rows))
-    elif static_text is None:
-        static_report[:] = False
+        static = any_dimension(*fields.dimensions.of_rows(rows))
+        if not static.all():
+            static[~static] = static_text.present(take(rows[~static], static_text.columns))
+        static_report[rows] = static
     ledger.use(int(static_report.sum()))
     reject(
         no_position & ~static_report,
@@ -420,8 +467,7 @@ def _classify(
         "latitude",
         "no position: latitude",
     )
-    contributes = left & has_dimension
-    contributes &= ~(no_position & ~static_report)
+    contributes = left & ~(no_position & ~static_report)
     left &= ~no_position
 
     if query.region is not None and left.any():
@@ -431,7 +477,7 @@ def _classify(
         left[rows[~inside]] = False
     rows = np.flatnonzero(left)
     if rows.size:
-        table, bad_time = canonical(take(rows))
+        table, bad_time = canonical(take(rows, None))
         if bad_time.any():
             first = int(rows[np.flatnonzero(bad_time)[0]])
             ledger.reject(
@@ -444,7 +490,7 @@ def _classify(
         selected = _in_query(table, query)
         ledger.outside_query(int((~selected).sum()))
         result.kept.append(table.filter(pa.array(selected)))
-    result.add_dimensions(fields.mmsi, fields, contributes)
+    result.add_dimensions(fields.mmsi, fields.dimensions, contributes)
 
 
 def _in_query(table: pa.Table, query: Query) -> np.ndarray:
@@ -470,28 +516,27 @@ def _in_query(table: pa.Table, query: Query) -> np.ndarray:
 # -- canonical tables (NMEA, Parquet) ---------------------------------------------------------
 
 
+def _canonical_dimensions(table: pa.Table) -> Dimensions:
+    length_m, breadth_m, draught_m = (to_numpy_float(table.column(name)) for name in DIMENSIONS)
+    return length_m, breadth_m, draught_m
+
+
 def _canonical_fields(table: pa.Table) -> Fields:
     mmsi = pc.fill_null(table.column("mmsi"), -1).to_numpy()
-
-    def floats(name: str) -> np.ndarray:
-        return np.asarray(table.column(name).to_numpy(zero_copy_only=False), dtype=np.float64)
-
     n = table.num_rows
     return Fields(
         mmsi=np.asarray(mmsi, dtype=np.int64),
-        lat_deg=null_outside(floats("lat_deg"), -90.0, 90.0),
-        lon_deg=null_outside(floats("lon_deg"), -180.0, 180.0),
+        lat_deg=null_outside(to_numpy_float(table.column("lat_deg")), -90.0, 90.0),
+        lon_deg=null_outside(to_numpy_float(table.column("lon_deg")), -180.0, 180.0),
         vessel=is_vessel(table.column("mobile_type").combine_chunks()),
-        length_m=floats("length_m"),
-        breadth_m=floats("breadth_m"),
-        draught_m=floats("draught_m"),
+        dimensions=DimensionColumns(table.select(list(DIMENSIONS)), _canonical_dimensions),
         unparseable=np.zeros(n, dtype=bool),
         problem=[],
     )
 
 
-def _taker(table: pa.Table) -> Callable[[np.ndarray], pa.Table]:
-    return lambda rows: table.take(pa.array(rows))
+def _taker(table: pa.Table) -> Take:
+    return lambda rows, columns: table.take(pa.array(rows, pa.int64()))
 
 
 def _canonical_identity(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
@@ -501,9 +546,12 @@ def _canonical_identity(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
 
 def _canonical_static_text(table: pa.Table) -> np.ndarray:
     present = np.zeros(table.num_rows, dtype=bool)
-    for column in ("ship_type", "name", "callsign", "imo"):
+    for column in _CANONICAL_STATIC.columns:
         present |= np.asarray(table.column(column).is_valid().to_numpy(zero_copy_only=False))
     return present
+
+
+_CANONICAL_STATIC = _StaticText(("ship_type", "name", "callsign", "imo"), _canonical_static_text)
 
 
 def _table_example(name: str, table: pa.Table) -> Example:
@@ -562,25 +610,8 @@ def _nmea_batch(result: _FileResult, batch: AisBatch) -> None:
             example=f"{result.name}: static report: MMSI {int(mmsi[first])}",
         )
     result.ledger.use(int((~bad).sum()))
-    dims = {
-        name: np.asarray(statics.column(name).to_numpy(zero_copy_only=False), dtype=np.float64)
-        for name in DIMENSIONS
-    }
-    fields = Fields(
-        mmsi=mmsi,
-        lat_deg=np.full(len(mmsi), np.nan),
-        lon_deg=np.full(len(mmsi), np.nan),
-        vessel=np.ones(len(mmsi), dtype=bool),
-        length_m=dims["length_m"],
-        breadth_m=dims["breadth_m"],
-        draught_m=dims["draught_m"],
-        unparseable=np.zeros(len(mmsi), dtype=bool),
-        problem=[],
-    )
-    has_dimension = ~(
-        np.isnan(fields.length_m) & np.isnan(fields.breadth_m) & np.isnan(fields.draught_m)
-    )
-    result.add_dimensions(mmsi, fields, ~bad & has_dimension)
+    dimensions = DimensionColumns(statics.select(list(DIMENSIONS)), _canonical_dimensions)
+    result.add_dimensions(mmsi, dimensions, ~bad)
 
 
 def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResult:
@@ -612,7 +643,7 @@ def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResul
                 result,
                 _canonical_fields(table),
                 _taker(table),
-                static_text=_canonical_static_text,
+                static_text=_CANONICAL_STATIC,
                 canonical=_canonical_identity,
                 example=example,
             )

@@ -18,6 +18,8 @@ import pyarrow.compute as pc
 from .clean import (
     SHIP_TYPE_CATEGORIES,
     BoolArray,
+    DimensionColumns,
+    Dimensions,
     Fields,
     clean_angle,
     clean_sog,
@@ -66,7 +68,10 @@ NUMERIC_COLUMNS = (
     "width",
     "draft",
 )
+DIMENSION_COLUMNS = ("length", "width", "draft")
 STATIC_TEXT_COLUMNS = ("vesselname", "callsign", "imo")
+# What ``marinecadastre_static_text`` reads.
+STATIC_COLUMNS = ("vesseltype", *STATIC_TEXT_COLUMNS)
 _OTHER = "Other"
 
 
@@ -98,12 +103,15 @@ def marinecadastre_fields(batch: pa.RecordBatch) -> Fields:
         lat_deg=null_outside(lat, -90.0, 90.0),
         lon_deg=null_outside(lon, -180.0, 180.0),
         vessel=is_vessel(_mobile_type(batch.column("transceiverclass"))),
-        length_m=positive_or_nan(float_column(batch.column("length"))[0]),
-        breadth_m=positive_or_nan(float_column(batch.column("width"))[0]),
-        draught_m=positive_or_nan(float_column(batch.column("draft"))[0]),
+        dimensions=DimensionColumns(batch.select(list(DIMENSION_COLUMNS)), _dimensions),
         unparseable=unparseable,
         problem=problem,
     )
+
+
+def _dimensions(table: pa.Table) -> Dimensions:
+    length, breadth, draught = (float_column(table.column(c))[0] for c in DIMENSION_COLUMNS)
+    return positive_or_nan(length), positive_or_nan(breadth), positive_or_nan(draught)
 
 
 def marinecadastre_static_text(batch: pa.RecordBatch) -> BoolArray:
@@ -128,6 +136,7 @@ def marinecadastre_canonical(batch: pa.RecordBatch) -> tuple[pa.Table, BoolArray
         status_ok = (status >= 0) & (status <= 15) & (np.floor(status) == status)
     imo_text = pc.utf8_ltrim(pc.utf8_upper(clean_text(batch.column("imo"))), characters="IMO")
     imo, _ = float_column(imo_text)
+    length, breadth, draught = _dimensions(batch)
     table = pa.table(
         {
             "timestamp": stamps.cast(pa.timestamp("s", tz="UTC")),
@@ -145,9 +154,9 @@ def marinecadastre_canonical(batch: pa.RecordBatch) -> tuple[pa.Table, BoolArray
             ),
             "ship_type": ship_type_text(float_column(batch.column("vesseltype"))[0]),
             "mobile_type": _mobile_type(batch.column("transceiverclass")),
-            "length_m": nan_to_null(positive_or_nan(float_column(batch.column("length"))[0])),
-            "breadth_m": nan_to_null(positive_or_nan(float_column(batch.column("width"))[0])),
-            "draught_m": nan_to_null(positive_or_nan(float_column(batch.column("draft"))[0])),
+            "length_m": nan_to_null(length),
+            "breadth_m": nan_to_null(breadth),
+            "draught_m": nan_to_null(draught),
             "name": clean_text(batch.column("vesselname")),
             "callsign": clean_text(batch.column("callsign")),
             "imo": whole_positive(imo),

@@ -15,6 +15,7 @@ import io
 import zipfile
 import zlib
 from collections.abc import Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -96,27 +97,47 @@ def _zip_member(path: Path) -> str:
 
 
 class _CountingReader(io.RawIOBase):
-    """A raw binary reader that hashes and reports the bytes read through it."""
+    """A raw binary reader that hashes and reports the bytes read through it.
+
+    The bytes of a read are hashed on a thread of their own while the caller uses them, so
+    that hashing does not delay the CSV parse; the next read (or ``hexdigest``) waits for
+    it. The caller must not change a buffer it has read into before its next read, which
+    holds for the buffered and gzip readers above this one, and for ``csv_chunks``.
+    """
 
     def __init__(self, raw: BinaryIO, hasher: hashlib._Hash | None, progress: ProgressSink) -> None:
         self._raw = raw
         self._hasher = hasher
         self._progress = progress
+        self._hashing: Future[None] | None = None
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="colregs9-sha256")
 
     def readable(self) -> bool:
         return True
 
     def readinto(self, buffer: memoryview | bytearray) -> int:  # type: ignore[override]
+        self._hashed()
         count = self._raw.readinto(buffer)  # type: ignore[attr-defined]
         if count:
             if self._hasher is not None:
-                self._hasher.update(memoryview(buffer)[:count])
+                self._hashing = self._pool.submit(self._hasher.update, memoryview(buffer)[:count])
             self._progress.advance(count)
         return count or 0
+
+    def _hashed(self) -> None:
+        if self._hashing is not None:
+            self._hashing.result()
+            self._hashing = None
 
     def drain(self) -> None:
         while self.read(_CHUNK):
             pass
+        self._hashed()
+
+    def close(self) -> None:
+        self._hashed()
+        self._pool.shutdown()
+        super().close()
 
 
 class _Silent:
@@ -157,21 +178,24 @@ def open_data(source: Source, progress: ProgressSink | None = None) -> Iterator[
     try:
         with source.path.open("rb") as raw:
             if source.compression == "zip":
-                with zipfile.ZipFile(raw) as archive, archive.open(source.member or "") as member:
-                    counting = _CountingReader(member, None, sink)  # type: ignore[arg-type]
+                with (
+                    zipfile.ZipFile(raw) as archive,
+                    archive.open(source.member or "") as member,
+                    _CountingReader(member, None, sink) as counting,  # type: ignore[arg-type]
+                ):
                     yield OpenedData(
                         io.BufferedReader(counting, _CHUNK), counting, None, source.path
                     )
                 return
             hasher = hashlib.sha256()
-            counting = _CountingReader(raw, hasher, sink)
-            buffered = io.BufferedReader(counting, _CHUNK)
-            stream: BinaryIO = (
-                gzip.GzipFile(fileobj=buffered, mode="rb")  # type: ignore[assignment]
-                if source.compression == "gzip"
-                else buffered
-            )
-            yield OpenedData(stream, counting, hasher, source.path)
+            with _CountingReader(raw, hasher, sink) as counting:
+                buffered = io.BufferedReader(counting, _CHUNK)
+                stream: BinaryIO = (
+                    gzip.GzipFile(fileobj=buffered, mode="rb")  # type: ignore[assignment]
+                    if source.compression == "gzip"
+                    else buffered
+                )
+                yield OpenedData(stream, counting, hasher, source.path)
     except InputFileError:
         raise
     except _DECOMPRESSION_ERRORS as exc:
