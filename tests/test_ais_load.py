@@ -142,3 +142,25 @@ def test_dimensions_written_two_ways_are_one_report(tmp_path: Path) -> None:
     assert reports.to_dict("records") == [
         {"mmsi": 257739000, "length_m": 288.0, "breadth_m": 49.0, "draught_m": 11.4, "n_reports": 2}
     ]
+
+
+def test_kept_row_with_a_bad_timestamp_reports_no_dimensions(tmp_path: Path) -> None:
+    """Its block's dimensions are counted before its timestamp is read; the rejected row's
+    report is taken back, so the counts equal those of the file without it."""
+    lines = DMA26.read_text().splitlines()
+    tanker = lines[1]  # ARCTIC PRINCESS, 288 m as A+B (223+65)
+    later = tanker.replace("00:00:33", "00:01:33")
+    broken = tanker.replace("09/09/2024 00:00:33", "32/13/2024 99:00:00").replace(
+        ",223,65,25,24", ",300,65,25,24"
+    )
+    with_broken, without = tmp_path / "with.csv", tmp_path / "without.csv"
+    with_broken.write_text("\n".join([HEADER, tanker, broken, later]) + "\n")
+    without.write_text("\n".join([HEADER, tanker, later]) + "\n")
+    data = load_ais([with_broken])
+    assert data.ledger.rejects["unparseable"] == 1
+    assert data.ledger.examples["unparseable"] == [
+        f"{with_broken}:3: timestamp does not parse: '32/13/2024 99:00:00'"
+    ]
+    pd.testing.assert_frame_equal(data.dimension_reports, load_ais([without]).dimension_reports)
+    assert data.dimension_reports["length_m"].tolist() == [288.0]
+    assert data.dimension_reports["n_reports"].tolist() == [2]

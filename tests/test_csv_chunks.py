@@ -13,14 +13,16 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from colregs9_cli.ais import csv_chunks, dma
+from colregs9_cli.ais import csv_chunks, dma, load
 from colregs9_cli.ais.load import AisData, load_ais
 from colregs9_cli.errors import InputFileError
-from colregs9_cli.query import load_query
+from colregs9_cli.query import Query, Region, load_query
 
 ROOT = Path(__file__).resolve().parents[1]
 DMA26 = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
 MARINECADASTRE = ROOT / "fixtures" / "ais" / "marinecadastre_2023-01-11_sample.csv"
+DMA22 = ROOT / "fixtures" / "ais" / "aisdk_2018-06-01_sample_22col.csv"
+NMEA = ROOT / "fixtures" / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
 
 
 def _counts(data: AisData) -> dict[str, object]:
@@ -272,3 +274,27 @@ def test_blank_lines_before_the_header(
     assert data.ledger.examples["not_a_vessel"] == [
         f"{path}:{13 + lines_before}: mobile type 'AtoN'"
     ]
+
+
+# Boxes that hold some of each fixture's positions: (lat_min, lat_max, lon_min, lon_max).
+_BOXES = {
+    DMA26: (57.0, 58.0, 9.0, 12.5),
+    DMA22: (55.5, 57.0, 10.0, 12.0),
+    MARINECADASTRE: (29.0, 31.0, -95.0, -89.0),
+    NMEA: (55.5, 57.0, 10.0, 12.0),
+}
+
+
+@pytest.mark.parametrize("boxed", [False, True])
+@pytest.mark.parametrize("fixture", list(_BOXES))
+def test_rows_set_aside_give_the_same_result_in_any_batch(
+    monkeypatch: pytest.MonkeyPatch, fixture: Path, boxed: bool
+) -> None:
+    """The rows kept and the rows without a position are converted in batches; converting
+    them after every chunk of a few lines changes nothing."""
+    query = Query(name="box", region=Region(*_BOXES[fixture])) if boxed else None
+    whole = load_ais([fixture], query=query)
+    assert whole.rows_in_query > 0
+    monkeypatch.setattr(load, "_SET_ASIDE_BYTES", 1)
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", 400)
+    _same(load_ais([fixture], query=query), whole)

@@ -4,9 +4,12 @@ A DMA day file is mostly rows outside the query. Converting all of their columns
 makes a plain streaming read slow, so each chunk (``CHUNK_BYTES`` of whole lines) is parsed
 by pyarrow's ``read_csv`` on all cores with only the columns that every row needs
 (``row_columns``: position, MMSI, mobile type, dimensions). The few rows that the pipeline
-keeps are then cut out of the chunk's bytes by their line offsets and parsed again with all
-columns (``CsvChunk.take``). The next chunk is read and parsed on a worker thread while the
-caller works on the current one, so memory stays at about two chunks.
+keeps are then cut out of the chunk's bytes by their line offsets (``CsvChunk.cut``) and
+parsed again with all columns, together with rows cut from other chunks
+(``parse_cut_rows``): a parse of a few rows costs little itself, but waits for pyarrow's
+threads while they parse the next chunk. The next chunk is read and parsed on a worker
+thread while the caller works on the current one, so memory stays at about two chunks plus
+the rows cut out.
 
 A row is one non-empty line (ended by LF, CRLF or a lone CR; pyarrow skips empty lines),
 unless a quoted field holds a line end: chunks with such a record follow the records with
@@ -24,7 +27,7 @@ Each chunk falls back on its own, so a bad row costs one chunk, not the file:
 - The ``numeric`` columns are read as numbers (the ``whole`` ones as integers, which only
   the MMSI is). A chunk where one holds something else (``north`` for a latitude, ``N/A``, a
   decimal MMSI) is parsed again with every column as text, and the caller's cleaning sorts
-  the values out (``CsvChunk.text`` tells). The same holds for the rows cut out by ``take``.
+  the values out (``CsvChunk.text`` tells). The same holds for the rows cut out.
   Only an empty field is null: pyarrow's other null spellings (``NULL``, ``NA``, ...) cost
   every number a lookup, and the text path turns them to null.
 """
@@ -126,15 +129,70 @@ class CsvChunk:
     def take(self, rows: NDArray[np.int64], columns: Sequence[str] | None = None) -> pa.Table:
         """The given rows (indices into ``rows``), in that order, with ``columns`` (by
         default all) converted."""
-        columns = self._layout.all_columns if columns is None else columns
+        return parse_cut_rows([self.cut(rows)], columns)[0].table
+
+    def cut(self, rows: NDArray[np.int64]) -> CutRows:
+        """The given rows (indices into ``rows``) cut out of the chunk, to be parsed with
+        all columns later, together with rows cut from other chunks (``parse_cut_rows``)."""
         if self._row_spans is None:
-            whole, _ = _parse_numbers_or_text(self._data, self._layout, columns, self.text)
-            return whole.take(pa.array(rows, pa.int64()))
+            whole, _ = _parse_numbers_or_text(
+                self._data, self._layout, self._layout.all_columns, self.text
+            )
+            lines = np.full(len(rows), self._first_line, np.int64)
+            return CutRows(self._layout, lines, self.text, table=whole.take(pa.array(rows)))
         spans = self._row_spans
-        lines = _gather(self._data, spans.start[rows], spans.end[rows] + 1)
-        # On this thread: in pyarrow's pool these few rows would queue behind the next chunk.
-        table, _ = _parse_numbers_or_text(lines, self._layout, columns, self.text, threads=False)
-        return table
+        data = _gather(self._data, spans.start[rows], spans.end[rows] + 1)
+        return CutRows(self._layout, self._first_line + spans.first_line[rows], self.text, data)
+
+
+@dataclass(frozen=True)
+class CutRows:
+    """Rows cut out of a chunk: their bytes (or, where the chunk's records could not be
+    found, the rows already parsed) and the file line each starts on."""
+
+    layout: _Layout
+    lines: NDArray[np.int64]
+    text: bool
+    data: memoryview | None = None
+    table: pa.Table | None = None
+
+    @property
+    def size_bytes(self) -> int:
+        return len(self.data) if self.data is not None else 0
+
+
+@dataclass(frozen=True)
+class ParsedRows:
+    table: pa.Table
+    lines: NDArray[np.int64]
+
+
+def parse_cut_rows(
+    cuts: Sequence[CutRows], columns: Sequence[str] | None = None
+) -> list[ParsedRows]:
+    """The cut rows with ``columns`` (default: all) converted, in order: the rows given as
+    bytes are parsed in one go, and rows already parsed follow as they are.
+
+    Numbers are read as numbers where every cut row allows it, else every column as text
+    (``ParsedRows.table`` tells by its column types).
+    """
+    if not cuts:
+        return []
+    layout = cuts[0].layout
+    wanted = layout.all_columns if columns is None else columns
+    parsed: list[ParsedRows] = []
+    pieces = [cut for cut in cuts if cut.data is not None]
+    if pieces:
+        data = b"".join(cut.data for cut in pieces)  # type: ignore[misc]
+        text = any(cut.text for cut in pieces)
+        table, _ = _parse_numbers_or_text(memoryview(data), layout, wanted, text)
+        parsed.append(ParsedRows(table, np.concatenate([cut.lines for cut in pieces])))
+    parsed.extend(
+        ParsedRows(cut.table.select(list(wanted)), cut.lines)
+        for cut in cuts
+        if cut.table is not None
+    )
+    return parsed
 
 
 def _gather(data: memoryview, starts: NDArray[np.int64], stops: NDArray[np.int64]) -> memoryview:
@@ -331,13 +389,13 @@ def _parse_numbers_or_text(
     columns: Sequence[str],
     text: bool,
     invalid: list[tuple[int | None, int, int, str]] | None = None,
-    threads: bool = True,
 ) -> tuple[pa.Table, bool]:
-    """Parse with numbers as numbers, on all cores if ``threads``; again on one thread if a
-    row is malformed (for its line number), and again as text if a number column holds
-    text. Returns the table and whether it was read as text. Malformed rows are skipped
-    and go to ``invalid``.
+    """Parse with numbers as numbers, on all cores; again on one thread if a row is
+    malformed (for its line number), and again as text if a number column holds text.
+    Returns the table and whether it was read as text. Malformed rows are skipped and go to
+    ``invalid``.
     """
+    threads = True
     while True:
         found: list[tuple[int | None, int, int, str]] = []
 

@@ -29,23 +29,31 @@ the query, position rows and static reports alike, minus rows rejected in steps 
 It is restricted to the vessels that have a position in the query. Rows outside the region
 are not checked for a bad timestamp or duplicates, so they count as reports as they are.
 
+Steps 1-3, the region test of step 5 and the dimension counts are done block by block on
+the columns every row needs. The rows inside the region, and the rows with neither a
+position nor a dimension (step 4 needs their text columns), are set aside and converted in
+batches of about ``_SET_ASIDE_BYTES`` (``_FileResult.settle``), which does the rest of steps
+4-7. A kept row whose timestamp does not parse was counted with its block; its report is
+taken back when it is settled.
+
 Memory: CSV is read in chunks of whole lines (``csv_chunks.CHUNK_BYTES``); a chunk is
-dropped once its rows in the query are kept, so memory grows with the kept rows, not with
-the file. Only the columns every row needs are converted for every row; the rest only for
-the rows kept and the static reports (see csv_chunks.py). A chunk whose numeric columns
-hold text is parsed again with every column as text, and a chunk with a malformed row again
-on one thread, which gives the row's line; the rest of the file is not affected. NMEA is
-decoded whole per file (see nmea.py).
+dropped once its rows in the query are cut out of it, so memory grows with the kept rows,
+not with the file. Only the columns every row needs are converted for every row; the rest
+only for the rows set aside (see csv_chunks.py). A chunk whose numeric columns hold text is
+parsed again with every column as text, and a chunk with a malformed row again on one
+thread, which gives the row's line; the rest of the file is not affected. NMEA is decoded
+whole per file (see nmea.py).
 """
 
 from __future__ import annotations
 
 import contextlib
 import io
+import re
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TypeAlias
 
 import numpy as np
 import pandas as pd
@@ -69,7 +77,7 @@ from .clean import (
     to_numpy_float,
     valid_mmsi,
 )
-from .csv_chunks import CsvChunk, NotUtf8, read_chunks
+from .csv_chunks import CsvChunk, CutRows, NotUtf8, ParsedRows, parse_cut_rows, read_chunks
 from .detect import CSV_LAYOUTS, LAYOUTS, csv_header, detect_layout
 from .ledger import RejectReason, RejectsLedger
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
@@ -89,8 +97,11 @@ PARQUET_BATCH_ROWS = 256 * 1024
 DIMENSIONS = ("length_m", "breadth_m", "draught_m")
 DIMENSION_REPORT_COLUMNS = ("mmsi", *DIMENSIONS, "n_reports")
 _EXAMPLE_CHARS = 160
+_DECIMAL = re.compile(r"[-+]?\d+(\.\d*)?")
 # Merge the per-block dimension counts once this many have piled up.
 _DIMENSION_PARTS_BEFORE_MERGE = 64
+# Convert the rows set aside once they hold this many bytes (see ``_FileResult.set_aside``).
+_SET_ASIDE_BYTES = 8 * 1024 * 1024
 
 
 @dataclass(frozen=True)
@@ -175,17 +186,111 @@ def _merge_ledger(into: RejectsLedger, part: RejectsLedger) -> None:
 # -- one file ---------------------------------------------------------------------------------
 
 
+Example = Callable[[int, str, str], str]
+# Rows of a block set aside: cut out of a CSV chunk, or taken from a canonical table.
+_Part: TypeAlias = CutRows | pa.Table
+
+
+@dataclass(frozen=True)
+class _StaticText:
+    """Tells the rows without a position that carry static text (a static report) from
+    those that carry nothing, by reading ``columns``."""
+
+    columns: tuple[str, ...]
+    present: Callable[[pa.Table], np.ndarray]
+
+
+@dataclass(frozen=True)
+class _Converted:
+    """Rows set aside with all their columns, and how to quote one of them in the ledger."""
+
+    table: pa.Table
+    example: Example
+
+
+@dataclass(frozen=True)
+class _Conversion:
+    """How a reader turns the rows it set aside into canonical rows.
+
+    ``convert`` gives the parts' rows with all columns (in one or more tables);
+    ``canonical`` turns those into the canonical schema and tells the rows whose timestamp
+    does not parse; ``static_text`` None: a row without a position is never a static
+    report (NMEA position messages).
+    """
+
+    convert: Callable[[list[_Part]], list[_Converted]]
+    canonical: Callable[[pa.Table], tuple[pa.Table, np.ndarray]]
+    static_text: _StaticText | None
+
+
 @dataclass
 class _FileResult:
-    """What one file contributed; merged into the run only when the file was read whole."""
+    """What one file contributed; merged into the run only when the file was read whole.
+
+    The rows inside the region and the rows with neither a position nor a dimension are
+    set aside block by block and converted in batches (``settle``): their other columns are
+    wanted for few rows, and converting them a few rows at a time costs more than the
+    conversion itself, most of all while the next CSV chunk is parsed on every core.
+    """
 
     query: Query
     name: str
+    conversion: _Conversion
     ledger: RejectsLedger = field(default_factory=RejectsLedger)
     kept: list[pa.Table] = field(default_factory=list)
     dimension_parts: list[pa.Table] = field(default_factory=list)
     layout: str = ""
     sha256: str = ""
+    _kept_aside: list[_Part] = field(default_factory=list)
+    _static_aside: list[_Part] = field(default_factory=list)
+    _aside_bytes: int = 0
+
+    def set_aside(self, kept: _Part | None = None, static: _Part | None = None) -> None:
+        """Set aside rows in the region (``kept``) and rows to be told static reports or
+        rows without a position (``static``); settle once enough have gathered."""
+        for part, parts in ((kept, self._kept_aside), (static, self._static_aside)):
+            if part is not None:
+                parts.append(part)
+                self._aside_bytes += part.size_bytes if isinstance(part, CutRows) else part.nbytes
+        if self._aside_bytes >= _SET_ASIDE_BYTES:
+            self.settle()
+
+    def settle(self) -> None:
+        """Convert the rows set aside and account for them (steps 4-7 of the module doc)."""
+        kept, static = self._kept_aside, self._static_aside
+        self._kept_aside, self._static_aside, self._aside_bytes = [], [], 0
+        ledger = self.ledger
+        if static:
+            static_text = self.conversion.static_text
+            assert static_text is not None, "rows are set aside as static only with static text"
+            for part in self.conversion.convert(static):
+                present = static_text.present(part.table)
+                ledger.use(int(present.sum()))
+                absent = np.flatnonzero(~present)
+                if absent.size:
+                    reason = RejectReason.NO_POSITION
+                    ledger.reject(
+                        reason,
+                        int(absent.size),
+                        example=part.example(int(absent[0]), "latitude", "no position: latitude")
+                        if ledger.wants_example(reason)
+                        else None,
+                    )
+        for part in self.conversion.convert(kept) if kept else ():
+            table, bad_time = self.conversion.canonical(part.table)
+            if bad_time.any():
+                ledger.reject(
+                    RejectReason.UNPARSEABLE,
+                    int(bad_time.sum()),
+                    example=part.example(
+                        int(np.flatnonzero(bad_time)[0]), "time", "timestamp does not parse:"
+                    ),
+                )
+                self._uncount_dimensions(table.filter(pa.array(bad_time)))
+                table = table.filter(pa.array(~bad_time))
+            selected = _in_query(table, self.query)
+            ledger.outside_query(int((~selected).sum()))
+            self.kept.append(table.filter(pa.array(selected)))
 
     def add_dimensions(
         self, mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray
@@ -193,7 +298,27 @@ class _FileResult:
         """Count the dimensions reported by ``rows`` (a mask); rows without any are left out."""
         if not rows.any():
             return
-        self.dimension_parts.append(_count_reports(mmsi, dimensions, rows))
+        self._add_counts(_count_reports(mmsi, dimensions, rows))
+
+    def _uncount_dimensions(self, rows: pa.Table) -> None:
+        """Take back the dimensions counted for canonical ``rows`` that were rejected after
+        their block was counted."""
+        length_m, breadth_m, draught_m = _canonical_dimensions(rows)
+        reported = any_dimension(length_m, breadth_m, draught_m)
+        if reported.any():
+            mmsi = rows.column("mmsi").to_numpy()[reported]
+            self._add_counts(
+                _count_combinations(
+                    mmsi,
+                    length_m[reported],
+                    breadth_m[reported],
+                    draught_m[reported],
+                    times=np.full(len(mmsi), -1),
+                )
+            )
+
+    def _add_counts(self, counts: pa.Table) -> None:
+        self.dimension_parts.append(counts)
         if len(self.dimension_parts) >= _DIMENSION_PARTS_BEFORE_MERGE:
             self.dimension_parts = [_sum_counts(self.dimension_parts)]
 
@@ -328,7 +453,8 @@ def _read_csv(
             f"{source.name}: the {layout} layout needs the column {missing[0]!r}, which the "
             f"header does not have; check the file or the --format given"
         )
-    result = _FileResult(query, source.name, layout=layout)
+    conversion = _Conversion(_csv_conversion(source.name, spec), spec.canonical, spec.static_text)
+    result = _FileResult(query, source.name, conversion, layout=layout)
     with open_data(source, bar) as opened:
         chunks = read_chunks(
             opened.stream,
@@ -343,6 +469,7 @@ def _read_csv(
             with contextlib.closing(chunks):
                 for chunk in chunks:
                     _csv_chunk(result, spec, chunk)
+            result.settle()
         except NotUtf8:
             raise _non_utf8_error(source) from None
         except pa.ArrowInvalid as exc:
@@ -385,48 +512,45 @@ def _csv_chunk(result: _FileResult, spec: _CsvLayout, chunk: CsvChunk) -> None:
             value = rows.column(column)[row].as_py()
         else:
             value = chunk.take(np.array([row]), [column]).column(column)[0].as_py()
-        if isinstance(value, float) and value.is_integer():
-            value = int(value)
-        return f"{result.name}:{chunk.line_of(row)}: {why} {value!r}"
+        return _line_example(result.name, chunk.line_of(row), why, value)
 
-    _classify(
-        result,
-        spec.fields(rows),
-        chunk.take,
-        static_text=spec.static_text,
-        canonical=spec.canonical,
-        example=example,
-    )
+    _classify(result, spec.fields(rows), chunk.cut, example)
 
 
-Example = Callable[[int, str, str], str]
+def _line_example(name: str, line: int, why: str, value: object) -> str:
+    # A chunk read as text gives its numbers as text: quote them as numbers all the same.
+    if isinstance(value, str) and _DECIMAL.fullmatch(value):
+        value = float(value)
+    if isinstance(value, float) and value.is_integer():
+        value = int(value)
+    return f"{name}:{line}: {why} {value!r}"
 
 
-@dataclass(frozen=True)
-class _StaticText:
-    """Tells the rows without a position that carry static text (a static report) from
-    those that carry nothing, by reading ``columns``."""
+def _csv_conversion(name: str, spec: _CsvLayout) -> Callable[[list[_Part]], list[_Converted]]:
+    def convert(parts: list[_Part]) -> list[_Converted]:
+        cuts = [part for part in parts if isinstance(part, CutRows)]
+        return [
+            _Converted(rows.table, _cut_example(name, spec, rows)) for rows in parse_cut_rows(cuts)
+        ]
 
-    columns: tuple[str, ...]
-    present: Callable[[pa.Table], np.ndarray]
+    return convert
 
 
-Take = Callable[[np.ndarray, Sequence[str] | None], pa.Table]
+def _cut_example(name: str, spec: _CsvLayout, rows: ParsedRows) -> Example:
+    def example(row: int, what: str, why: str) -> str:
+        value = rows.table.column(spec.example_columns[what])[row].as_py()
+        return _line_example(name, int(rows.lines[row]), why, value)
+
+    return example
 
 
 def _classify(
-    result: _FileResult,
-    fields: Fields,
-    take: Take,
-    static_text: _StaticText | None,
-    canonical: Callable[[Any], tuple[pa.Table, np.ndarray]],
-    example: Example,
+    result: _FileResult, fields: Fields, cut: Callable[[np.ndarray], _Part], example: Example
 ) -> None:
-    """Account every row of one block (see the module docstring) and keep the query's rows.
+    """Account every row of one block (see the module docstring) and set aside the rows
+    whose other columns decide the rest (``_FileResult.settle``).
 
-    ``take(rows, columns)`` gives those rows of the block with ``columns`` (None: all).
-    ``static_text`` None: a row without a position is never a static report (NMEA
-    position messages).
+    ``cut(rows)`` gives those rows of the block, to be converted later.
     """
     ledger = result.ledger
     query = result.query
@@ -452,22 +576,20 @@ def _classify(
     reject(bad_mmsi, RejectReason.INVALID_MMSI, "MMSI", "MMSI")
     left &= ~bad_mmsi
 
+    # Every row past these checks counts: one without a position or a dimension adds
+    # nothing, and a kept row whose timestamp does not parse is taken back when settled.
+    result.add_dimensions(fields.mmsi, fields.dimensions, left)
     no_position = left & (np.isnan(fields.lat_deg) | np.isnan(fields.lon_deg))
-    static_report = np.zeros(len(fields), dtype=bool)
-    if static_text is not None and no_position.any():
+    if no_position.any():
         rows = np.flatnonzero(no_position)
-        static = any_dimension(*fields.dimensions.of_rows(rows))
-        if not static.all():
-            static[~static] = static_text.present(take(rows[~static], static_text.columns))
-        static_report[rows] = static
-    ledger.use(int(static_report.sum()))
-    reject(
-        no_position & ~static_report,
-        RejectReason.NO_POSITION,
-        "latitude",
-        "no position: latitude",
-    )
-    contributes = left & ~(no_position & ~static_report)
+        dimensioned = any_dimension(*fields.dimensions.of_rows(rows))
+        ledger.use(int(dimensioned.sum()))  # static reports with a dimension
+        undecided = np.zeros(len(fields), dtype=bool)
+        undecided[rows[~dimensioned]] = True
+        if result.conversion.static_text is None:
+            reject(undecided, RejectReason.NO_POSITION, "latitude", "no position: latitude")
+        elif undecided.any():
+            result.set_aside(static=cut(np.flatnonzero(undecided)))
     left &= ~no_position
 
     if query.region is not None and left.any():
@@ -475,22 +597,8 @@ def _classify(
         inside = query.region.contains(fields.lat_deg[rows], fields.lon_deg[rows])
         ledger.outside_query(int((~inside).sum()))
         left[rows[~inside]] = False
-    rows = np.flatnonzero(left)
-    if rows.size:
-        table, bad_time = canonical(take(rows, None))
-        if bad_time.any():
-            first = int(rows[np.flatnonzero(bad_time)[0]])
-            ledger.reject(
-                RejectReason.UNPARSEABLE,
-                int(bad_time.sum()),
-                example=example(first, "time", "timestamp does not parse:"),
-            )
-            contributes[rows[bad_time]] = False
-            table = table.filter(pa.array(~bad_time))
-        selected = _in_query(table, query)
-        ledger.outside_query(int((~selected).sum()))
-        result.kept.append(table.filter(pa.array(selected)))
-    result.add_dimensions(fields.mmsi, fields.dimensions, contributes)
+    if left.any():
+        result.set_aside(kept=cut(np.flatnonzero(left)))
 
 
 def _in_query(table: pa.Table, query: Query) -> np.ndarray:
@@ -535,8 +643,16 @@ def _canonical_fields(table: pa.Table) -> Fields:
     )
 
 
-def _taker(table: pa.Table) -> Take:
-    return lambda rows, columns: table.take(pa.array(rows, pa.int64()))
+def _taker(table: pa.Table) -> Callable[[np.ndarray], _Part]:
+    return lambda rows: table.take(pa.array(rows, pa.int64()))
+
+
+def _table_conversion(name: str, static_text: _StaticText | None) -> _Conversion:
+    def convert(parts: list[_Part]) -> list[_Converted]:
+        table = pa.concat_tables(part for part in parts if isinstance(part, pa.Table))
+        return [_Converted(table, _table_example(name, table))]
+
+    return _Conversion(convert, _canonical_identity, static_text)
 
 
 def _canonical_identity(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
@@ -569,7 +685,7 @@ def _table_example(name: str, table: pa.Table) -> Example:
 def _read_nmea(source: Source, query: Query, bar: ProgressSink) -> _FileResult:
     from .nmea import read_nmea
 
-    result = _FileResult(query, source.name, layout="nmea")
+    result = _FileResult(query, source.name, _table_conversion(source.name, None), layout="nmea")
     with open_data(source, bar) as opened:
         text = io.TextIOWrapper(opened.stream, encoding="utf-8", errors="replace", newline="")
         try:
@@ -579,6 +695,7 @@ def _read_nmea(source: Source, query: Query, bar: ProgressSink) -> _FileResult:
         result.sha256 = opened.finish()
     for batch in batches:
         _nmea_batch(result, batch)
+    result.settle()
     return result
 
 
@@ -593,9 +710,7 @@ def _nmea_batch(result: _FileResult, batch: AisBatch) -> None:
         result,
         _canonical_fields(positions),
         _taker(positions),
-        static_text=None,
-        canonical=_canonical_identity,
-        example=_table_example(result.name, positions),
+        _table_example(result.name, positions),
     )
     statics = batch.statics
     if statics.num_rows == 0:
@@ -619,7 +734,8 @@ def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResul
         raise InputFileError(
             f"{source.name}: a compressed Parquet file; give the .parquet file itself"
         )
-    result = _FileResult(query, source.name, layout="parquet")
+    conversion = _table_conversion(source.name, _CANONICAL_STATIC)
+    result = _FileResult(query, source.name, conversion, layout="parquet")
     try:
         parquet = pq.ParquetFile(source.path)
     except (pa.ArrowException, OSError) as exc:
@@ -631,22 +747,16 @@ def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResul
             f"{source.name}: the Parquet file lacks the canonical column {missing[0]!r}; "
             f"it needs {', '.join(CANONICAL_COLUMNS)}"
         )
-    example = None
     try:
         for record_batch in parquet.iter_batches(
             batch_size=PARQUET_BATCH_ROWS, columns=list(CANONICAL_COLUMNS)
         ):
             table = _to_canonical(source, pa.Table.from_batches([record_batch]))
             result.ledger.read(table.num_rows)
-            example = _table_example(result.name, table)
             _classify(
-                result,
-                _canonical_fields(table),
-                _taker(table),
-                static_text=_CANONICAL_STATIC,
-                canonical=_canonical_identity,
-                example=example,
+                result, _canonical_fields(table), _taker(table), _table_example(result.name, table)
             )
+        result.settle()
     except (pa.ArrowException, OSError) as exc:
         raise InputFileError(f"{source.name}: cannot read the Parquet file ({exc})") from None
     bar.advance(source.size_bytes)
