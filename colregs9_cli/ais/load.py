@@ -308,7 +308,7 @@ class _FileResult:
         if reported.any():
             mmsi = rows.column("mmsi").to_numpy()[reported]
             self._add_counts(
-                _count_combinations(
+                _report_rows(
                     mmsi,
                     length_m[reported],
                     breadth_m[reported],
@@ -324,8 +324,9 @@ class _FileResult:
 
 
 def _count_reports(mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray) -> pa.Table:
-    """``_count_combinations`` of the cleaned dimensions of ``rows``, without the rows that
-    report none. The rows are grouped as read first, and only the groups are cleaned."""
+    """The reports (``_report_rows``) of the cleaned dimensions of ``rows``, without the
+    rows that report none. The rows are grouped as read first, and only the groups are
+    cleaned; groups that clean alike are summed later."""
     key = "mmsi"
     while key in dimensions.table.column_names:
         key = f"_{key}"
@@ -334,7 +335,7 @@ def _count_reports(mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndar
     groups = groups.filter(pc.not_equal(groups.column(key), -1))
     length_m, breadth_m, draught_m = dimensions.clean(groups)
     reported = any_dimension(length_m, breadth_m, draught_m)
-    return _count_combinations(
+    return _report_rows(
         groups.column(key).to_numpy()[reported],
         length_m[reported],
         breadth_m[reported],
@@ -343,20 +344,17 @@ def _count_reports(mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndar
     )
 
 
-def _count_combinations(
+def _report_rows(
     mmsi: np.ndarray,
     length_m: np.ndarray,
     breadth_m: np.ndarray,
     draught_m: np.ndarray,
     times: np.ndarray | None = None,
 ) -> pa.Table:
-    """How often each (mmsi, length, breadth, draught) occurs, each row counting ``times``
-    (default once); NaN dimensions group as null.
-
-    Arrow's hash grouping, about twice as fast as pandas'; on the calling thread, as the CSV
-    reader keeps pyarrow's thread pool busy.
-    """
-    table = pa.table(
+    """Reports as rows of ``DIMENSION_REPORT_COLUMNS``, each counting ``times`` (default
+    once); NaN dimensions become null. A combination may take several rows until the rows
+    are summed (``_sum_counts``)."""
+    return pa.table(
         {
             "mmsi": pa.array(mmsi, pa.int64()),
             "length_m": pa.array(length_m, pa.float64(), from_pandas=True),
@@ -365,11 +363,14 @@ def _count_combinations(
             "n_reports": pa.array(np.ones(len(mmsi)) if times is None else times, pa.int64()),
         }
     )
-    return _sum_counts([table])
 
 
 def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
-    """Counts of (mmsi, dimensions) from several parts combined into one per combination."""
+    """Counts of (mmsi, dimensions) from several parts combined into one per combination.
+
+    Arrow's hash grouping, about twice as fast as pandas'; on the calling thread, as the CSV
+    reader keeps pyarrow's thread pool busy.
+    """
     summed = (
         pa.concat_tables(parts)
         .group_by(["mmsi", *DIMENSIONS], use_threads=False)
@@ -802,9 +803,7 @@ class _Collected:
         positions = positions.sort_values(["mmsi", "timestamp"], kind="stable", ignore_index=True)
         duplicate = positions.duplicated(keep="first").to_numpy()
         empty = np.empty(0)
-        counts = _sum_counts(
-            [_count_combinations(empty, empty, empty, empty), *self.dimension_parts]
-        )
+        counts = _sum_counts([_report_rows(empty, empty, empty, empty), *self.dimension_parts])
         if duplicate.any():
             dropped = positions.loc[duplicate]
             first = dropped.iloc[0]
@@ -829,11 +828,11 @@ def _subtract_counts(counts: pa.Table, dropped: pd.DataFrame) -> pa.Table:
     frame = frame[frame[list(DIMENSIONS)].notna().any(axis=1)]
     if frame.empty:
         return counts
-    removed = _count_combinations(*(frame[c].to_numpy() for c in ["mmsi", *DIMENSIONS]))
-    negated = removed.set_column(
-        len(DIMENSION_REPORT_COLUMNS) - 1, "n_reports", pc.negate(removed.column("n_reports"))
+    length_m, breadth_m, draught_m = (frame[dimension].to_numpy() for dimension in DIMENSIONS)
+    removed = _report_rows(
+        frame["mmsi"].to_numpy(), length_m, breadth_m, draught_m, times=np.full(len(frame), -1)
     )
-    return _sum_counts([counts, negated])
+    return _sum_counts([counts, removed])
 
 
 def _to_pandas(table: pa.Table) -> pd.DataFrame:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import resource
 import shutil
 import subprocess
@@ -99,12 +100,16 @@ def _child(tool: str, csv_path: Path, out_dir: Path) -> None:
 
 
 def _measure(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
+    # Cached bytecode, as on a user's machine: PYTHONDONTWRITEBYTECODE (set on some CI and
+    # sandbox images) would have colregs9's own modules compiled again in every run.
+    environment = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     started = time.perf_counter()
     completed = subprocess.run(
         [sys.executable, __file__, "--child", tool, str(csv_path), str(out_dir)],
         capture_output=True,
         text=True,
         check=False,
+        env=environment,
     )
     wall_s = time.perf_counter() - started
     if completed.returncode != 0:
