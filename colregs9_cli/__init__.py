@@ -1,8 +1,4 @@
 """colregs9: COLREGs rule 9 (narrow channels) audits of historical AIS."""
 
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("colregs9")
-except PackageNotFoundError:  # running from a source tree that is not installed
-    __version__ = "0.0.0+unknown"
+# The one place of the version: pyproject.toml reads it from here.
+__version__ = "0.1.0"

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from datetime import UTC, date, datetime, time
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
@@ -39,7 +39,9 @@ from shapely.geometry.base import BaseGeometry
 from .ais.schema import VESSEL_MOBILE_TYPES
 from .config import read_toml
 from .errors import InputFileError, QueryError
-from .geo import LocalFrame
+
+if TYPE_CHECKING:
+    from .geo import LocalFrame
 
 TOP_LEVEL_KEYS = frozenset(
     {"name", "description", "region", "time", "vessels", "manoeuvrability", "colregs", "replay"}
@@ -253,6 +255,9 @@ class Query:
 
     def frame(self) -> LocalFrame | None:
         """The run's local metric frame, centred on the region's box; None without a region."""
+        # pyproj is imported here, by the commands that project, not by every read.
+        from .geo import LocalFrame
+
         if self.region is None:
             return None
         r = self.region

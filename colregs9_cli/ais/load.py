@@ -259,38 +259,44 @@ class _FileResult:
         """Convert the rows set aside and account for them (steps 4-7 of the module doc)."""
         kept, static = self._kept_aside, self._static_aside
         self._kept_aside, self._static_aside, self._aside_bytes = [], [], 0
-        ledger = self.ledger
-        if static:
-            static_text = self.conversion.static_text
-            assert static_text is not None, "rows are set aside as static only with static text"
-            for part in self.conversion.convert(static):
-                present = static_text.present(part.table)
-                ledger.use(int(present.sum()))
-                absent = np.flatnonzero(~present)
-                if absent.size:
-                    reason = RejectReason.NO_POSITION
-                    ledger.reject(
-                        reason,
-                        int(absent.size),
-                        example=part.example(int(absent[0]), "latitude", "no position: latitude")
-                        if ledger.wants_example(reason)
-                        else None,
-                    )
+        for part in self.conversion.convert(static) if static else ():
+            self._settle_static(part)
         for part in self.conversion.convert(kept) if kept else ():
-            table, bad_time = self.conversion.canonical(part.table)
-            if bad_time.any():
-                ledger.reject(
-                    RejectReason.UNPARSEABLE,
-                    int(bad_time.sum()),
-                    example=part.example(
-                        int(np.flatnonzero(bad_time)[0]), "time", "timestamp does not parse:"
-                    ),
-                )
-                self._uncount_dimensions(table.filter(pa.array(bad_time)))
-                table = table.filter(pa.array(~bad_time))
-            selected = _in_query(table, self.query)
-            ledger.outside_query(int((~selected).sum()))
-            self.kept.append(table.filter(pa.array(selected)))
+            self._settle_kept(part)
+
+    def _settle_static(self, part: _Converted) -> None:
+        """Rows with neither a position nor a dimension: a static report if they carry
+        static text, else rejected."""
+        static_text = self.conversion.static_text
+        assert static_text is not None, "rows are set aside as static only with static text"
+        present = static_text.present(part.table)
+        self.ledger.use(int(present.sum()))
+        absent = np.flatnonzero(~present)
+        reason = RejectReason.NO_POSITION
+        if absent.size:
+            example = (
+                part.example(int(absent[0]), "latitude", "no position: latitude")
+                if self.ledger.wants_example(reason)
+                else None
+            )
+            self.ledger.reject(reason, int(absent.size), example=example)
+
+    def _settle_kept(self, part: _Converted) -> None:
+        """Rows in the region: canonical, then checked for their timestamp, the time window
+        and the vessel filter."""
+        table, bad_time = self.conversion.canonical(part.table)
+        if bad_time.any():
+            first = int(np.flatnonzero(bad_time)[0])
+            self.ledger.reject(
+                RejectReason.UNPARSEABLE,
+                int(bad_time.sum()),
+                example=part.example(first, "time", "timestamp does not parse:"),
+            )
+            self._uncount_dimensions(table.filter(pa.array(bad_time)))
+            table = table.filter(pa.array(~bad_time))
+        selected = _in_query(table, self.query)
+        self.ledger.outside_query(int((~selected).sum()))
+        self.kept.append(table.filter(pa.array(selected)))
 
     def add_dimensions(
         self, mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray
