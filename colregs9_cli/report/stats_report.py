@@ -136,7 +136,8 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
         axis.yaxis.set_major_locator(MaxNLocator(integer=True))
         axis.set_xlabel(label)
         axis.set_ylabel(result.unit_name)
-        axis.set_title(f"{label}: n = {values.size}")
+        # A set height spares matplotlib its search for tick labels above the axes.
+        axis.set_title(f"{label}: n = {values.size}", y=1.0)
     figure.suptitle(_title(result, query_name))
     return figure
 

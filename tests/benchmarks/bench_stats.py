@@ -9,16 +9,18 @@ on the same file in the same run, times each tool in its own subprocess:
 - ``duckdb``: ``SELECT * FROM read_csv(...) WHERE box``.
 
 Wall time is measured by the parent around the subprocess (interpreter start and imports
-included, the same for all); with ``--repeat N`` the tools take turns N times (round-robin, so
-that a slow spell of the machine hits all of them) and each tool's fastest run counts, the
-usual choice on a machine shared with other work. CPU time (user + system, all threads) is
+included, the same for all). The tools take turns ``--repeat`` times (rounds, round-robin, so
+that a slow spell of the machine hits all of them). Reported per tool: its fastest run (the
+usual choice on a machine shared with other work) and its median run, and the median over
+rounds of its time over the fastest tool's time in the same round, which is steadier where
+the machine's speed drifts from one minute to the next. CPU time (user + system, all threads) is
 the child's own. Peak RSS is the child's ``VmHWM`` from ``/proc/self/status`` at exit:
 unlike ``ru_maxrss``, which Linux carries over from the parent across fork and exec, it starts
 afresh in the new process, so each figure belongs to one tool. The files are generated in a
 subprocess too. Every tool reports the rows and vessels it selected, so that the results can
 be seen to agree.
 
-Usage: python tests/benchmarks/bench_stats.py [--sizes 2500000 5000000] [--repeat 1]
+Usage: python tests/benchmarks/bench_stats.py [--sizes 2500000 5000000] [--repeat 3]
 Needs the ``bench`` extra (polars, duckdb).
 """
 
@@ -29,6 +31,7 @@ import json
 import os
 import resource
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -120,7 +123,7 @@ def _measure(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[2_500_000, 5_000_000])
-    parser.add_argument("--repeat", type=int, default=1, help="runs per tool; the fastest counts")
+    parser.add_argument("--repeat", type=int, default=3, help="rounds of runs (round-robin)")
     parser.add_argument("--keep", action="store_true", help="keep the generated files")
     parser.add_argument("--child", nargs=3, metavar=("TOOL", "CSV", "OUT"), help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -144,16 +147,25 @@ def main() -> None:
             size_mb = csv_path.stat().st_size / 1e6
             print(f"\n{rows:,} rows, {size_mb:,.0f} MB")
             # Round-robin, so that a slow spell of the machine hits every tool alike.
-            runs_of: dict[str, list[dict[str, Any]]] = {tool: [] for tool in TOOLS}
-            for _ in range(args.repeat):
-                for tool in TOOLS:
-                    runs_of[tool].append(_measure(tool, csv_path, workdir / "out"))
-            for tool, runs in runs_of.items():
+            rounds = [
+                {tool: _measure(tool, csv_path, workdir / "out") for tool in TOOLS}
+                for _ in range(args.repeat)
+            ]
+            for tool in TOOLS:
+                runs = [measured[tool] for measured in rounds]
+                # This machine's speed drifts within minutes: within one round the tools ran
+                # close together, so the ratio to the round's fastest tool is steadier.
+                ratios = [
+                    measured[tool]["wall_s"] / min(m["wall_s"] for m in measured.values())
+                    for measured in rounds
+                ]
                 result = {
                     "rows_in_file": rows,
                     "file_mb": size_mb,
                     "tool": tool,
                     "wall_s": min(r["wall_s"] for r in runs),
+                    "median_wall_s": statistics.median(r["wall_s"] for r in runs),
+                    "round_ratio": statistics.median(ratios),
                     "cpu_s": min(r["cpu_s"] for r in runs),
                     "peak_rss_mb": max(r["peak_rss_mb"] for r in runs),
                     "rows": runs[0]["rows"],
@@ -161,8 +173,9 @@ def main() -> None:
                 }
                 results.append(result)
                 print(
-                    f"  {tool:18s} {result['wall_s']:7.2f} s  cpu {result['cpu_s']:6.2f} s  "
-                    f"{result['peak_rss_mb']:7.0f} MB"
+                    f"  {tool:18s} {result['wall_s']:7.2f} s (median {result['median_wall_s']:.2f})"
+                    f"  × round's fastest {result['round_ratio']:.2f}"
+                    f"  cpu {result['cpu_s']:6.2f} s  {result['peak_rss_mb']:7.0f} MB"
                     f"  rows {result['rows']:,}  vessels {result['vessels']:,}"
                 )
             csv_path.unlink()
@@ -171,19 +184,19 @@ def main() -> None:
             shutil.rmtree(workdir, ignore_errors=True)
 
     print(
-        "\n| rows in file | file size | tool | wall time | × fastest | CPU time | peak RSS "
-        "| rows selected | vessels |"
+        "\n| rows in file | file size | tool | best wall | × fastest | median wall "
+        "| × round's fastest (median) | CPU time | peak RSS | rows selected | vessels |"
     )
-    print("|--:|--:|:--|--:|--:|--:|--:|--:|--:|")
+    print("|--:|--:|:--|--:|--:|--:|--:|--:|--:|--:|--:|")
     for rows in args.sizes:
         at_size = [r for r in results if r["rows_in_file"] == rows]
         fastest = min(r["wall_s"] for r in at_size)
         for r in at_size:
             print(
                 f"| {rows:,} | {r['file_mb']:,.0f} MB | {r['tool']} | {r['wall_s']:.1f} s "
-                f"| {r['wall_s'] / fastest:.2f} | {r['cpu_s']:.1f} s | {r['peak_rss_mb']:,.0f} MB "
-                f"| {r['rows']:,} "
-                f"| {r['vessels']:,} |"
+                f"| {r['wall_s'] / fastest:.2f} | {r['median_wall_s']:.1f} s "
+                f"| {r['round_ratio']:.2f} | {r['cpu_s']:.1f} s | {r['peak_rss_mb']:,.0f} MB "
+                f"| {r['rows']:,} | {r['vessels']:,} |"
             )
 
 
