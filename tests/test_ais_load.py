@@ -9,6 +9,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from colregs9_cli.ais import csv_chunks, load
 from colregs9_cli.ais.load import load_ais
 from colregs9_cli.errors import NoDataError
 from colregs9_cli.query import Query, Region, TimeWindow, VesselFilter, load_query
@@ -164,3 +165,34 @@ def test_kept_row_with_a_bad_timestamp_reports_no_dimensions(tmp_path: Path) -> 
     pd.testing.assert_frame_equal(data.dimension_reports, load_ais([without]).dimension_reports)
     assert data.dimension_reports["length_m"].tolist() == [288.0]
     assert data.dimension_reports["n_reports"].tolist() == [2]
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    rows=st.lists(dma_row(), min_size=1, max_size=30),
+    boxed=st.booleans(),
+    chunk_bytes=st.integers(min_value=1, max_value=2000),
+)
+def test_small_chunks_and_batches_change_nothing_on_generated_dma(
+    tmp_path: Path, rows: list[str], boxed: bool, chunk_bytes: int
+) -> None:
+    """Rows cut out of many small chunks and settled after each one give the same positions,
+    dimension reports and counts as one chunk settled once."""
+    anchor = (
+        "09/09/2024 00:00:40,Class A,219000179,57.05,9.95,Moored,0,0,90,91,Unknown,OVLI,NAME,"
+        "Cargo,,6,25,GPS,2.5,Unknown,,AIS,7,18,2,4"
+    )
+    path = tmp_path / "gen.csv"
+    path.write_text("\n".join([HEADER, *rows, anchor]) + "\n")
+    query = Query(name="q", region=Region(57.0, 57.1, 9.9, 10.0)) if boxed else None
+    whole = load_ais([path], query=query)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
+        patch.setattr(load, "_SET_ASIDE_BYTES", 1)
+        pieces = load_ais([path], query=query)
+    pd.testing.assert_frame_equal(pieces.positions, whole.positions)
+    pd.testing.assert_frame_equal(pieces.dimension_reports, whole.dimension_reports)
+    counts = {k: v for k, v in whole.ledger.to_dict().items() if k != "reject_examples"}
+    assert {k: v for k, v in pieces.ledger.to_dict().items() if k != "reject_examples"} == counts
