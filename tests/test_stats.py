@@ -12,19 +12,19 @@ from hypothesis import given
 from hypothesis import strategies as st
 from matplotlib.patches import Rectangle
 
-from colregs9_cli.report.stats_report import (
-    format_markdown,
-    format_text,
-    histogram_figure,
-    write_stats_reports,
-)
-from colregs9_cli.stats import (
+from colregs9_cli.dimensions import (
     GroupBy,
     Per,
     dimension_stats,
     vessel_medians,
     vessel_ship_types,
     weighted_median,
+)
+from colregs9_cli.report.stats_report import (
+    format_markdown,
+    format_text,
+    histogram_figure,
+    write_stats_reports,
 )
 
 A, B, C, D, E, F = 219000001, 219000002, 219000003, 219000004, 219000005, 219000006

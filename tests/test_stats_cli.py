@@ -21,8 +21,9 @@ from pyais.stream import IterMessages
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
+from colregs9_cli.dimensions import GroupBy, Per
 from colregs9_cli.report.stats_report import histogram_figure
-from colregs9_cli.stats import GroupBy, Per, run_stats
+from colregs9_cli.stats import run_stats
 
 ROOT = Path(__file__).resolve().parents[1]
 AIS = ROOT / "fixtures" / "ais"

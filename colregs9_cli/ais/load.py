@@ -47,7 +47,6 @@ whole per file (see nmea.py).
 
 from __future__ import annotations
 
-import contextlib
 import io
 import re
 from collections.abc import Callable, Iterator, Sequence
@@ -77,7 +76,8 @@ from .clean import (
     to_numpy_float,
     valid_mmsi,
 )
-from .csv_chunks import CsvChunk, CutRows, NotUtf8, ParsedRows, parse_cut_rows, read_chunks
+from .csv_chunks import CsvChunk, CutRows, NotUtf8, ParsedRows, parse_cut_rows
+from .csv_read import CsvReading, csv_columns, open_csv
 from .detect import CSV_LAYOUTS, LAYOUTS, csv_header, detect_layout
 from .ledger import RejectReason, RejectsLedger
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
@@ -133,11 +133,13 @@ def load_ais(
     query: Query | None = None,
     fmt: str | None = None,
     quiet: bool = True,
+    started: CsvReading | None = None,
 ) -> AisData:
     """Read AIS files (any mix of layouts) through ``query`` into cleaned positions.
 
     ``fmt`` forces the layout of every file (one of ``LAYOUTS``); by default each file's
-    layout is detected from its content. Raises ``InputFileError`` for unreadable files,
+    layout is detected from its content. ``started``: the first file, already being read
+    (``csv_read.start_reading``). Raises ``InputFileError`` for unreadable files,
     ``NoDataError`` (exit code 3) when no position row is left in the query.
     """
     query = query if query is not None else everything_query()
@@ -151,8 +153,8 @@ def load_ais(
     inputs: list[InputFile] = []
     total_bytes = float(sum(s.size_bytes for s in sources))
     with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet)) as bar:
-        for source in sources:
-            part = _read_source(source, fmt, query, bar)
+        for index, source in enumerate(sources):
+            part = _read_source(source, fmt, query, bar, started if index == 0 else None)
             _merge_ledger(ledger, part.ledger)
             collected.extend(part)
             inputs.append(InputFile(source.path, part.sha256, part.layout, part.ledger.rows_read))
@@ -387,21 +389,34 @@ def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
     )
 
 
-def _read_source(source: Source, fmt: str | None, query: Query, bar: ProgressSink) -> _FileResult:
+def _read_source(
+    source: Source, fmt: str | None, query: Query, bar: ProgressSink, started: CsvReading | None
+) -> _FileResult:
+    if started is not None:
+        started.attach_progress(bar)
+        return _read_csv(source, started.layout, query, started)
     head = read_head(source)
     layout = fmt if fmt is not None else detect_layout(source, head)
     if layout == "parquet":
         return _read_parquet(source, query, bar)
     if layout == "nmea":
         return _read_nmea(source, query, bar)
-    return _read_csv(source, layout, head, query, bar)
+    if layout not in CSV_LAYOUTS:
+        raise ParameterError(
+            f"--format {layout!r} is not a layout; use one of {', '.join(LAYOUTS)}"
+        )
+    header = csv_header(head, layout)
+    missing = [c for c in csv_columns(layout).columns if c not in header.columns]
+    if missing:
+        raise InputFileError(
+            f"{source.name}: the {layout} layout needs the column {missing[0]!r}, which the "
+            f"header does not have; check the file or the --format given"
+        )
+    return _read_csv(source, layout, query, open_csv(source, layout, head, bar))
 
 
 @dataclass(frozen=True)
 class _CsvLayout:
-    columns: tuple[str, ...]
-    row_columns: tuple[str, ...]  # what ``fields`` reads: converted for every row
-    numeric: tuple[str, ...]
     fields: Callable[[pa.RecordBatch], Fields]
     static_text: _StaticText
     canonical: Callable[[pa.RecordBatch], tuple[pa.Table, np.ndarray]]
@@ -412,9 +427,6 @@ def _csv_layout(layout: str) -> _CsvLayout:
     if layout in ("dma26", "dma22"):
         abcd = layout == "dma26"
         return _CsvLayout(
-            columns=dma.read_columns(abcd),
-            row_columns=dma.row_columns(abcd),
-            numeric=tuple(c for c in dma.NUMERIC_COLUMNS if abcd or c not in dma.ABCD),
             fields=lambda b: dma.dma_fields(b, abcd),
             static_text=_StaticText(dma.STATIC_TEXT_COLUMNS, dma.dma_static_text),
             canonical=lambda b: dma.dma_canonical(b, abcd),
@@ -427,9 +439,6 @@ def _csv_layout(layout: str) -> _CsvLayout:
             },
         )
     return _CsvLayout(
-        columns=marinecadastre.READ_COLUMNS,
-        row_columns=marinecadastre.ROW_COLUMNS,
-        numeric=marinecadastre.NUMERIC_COLUMNS,
         fields=marinecadastre.marinecadastre_fields,
         static_text=_StaticText(
             marinecadastre.STATIC_COLUMNS, marinecadastre.marinecadastre_static_text
@@ -445,37 +454,14 @@ def _csv_layout(layout: str) -> _CsvLayout:
     )
 
 
-def _read_csv(
-    source: Source, layout: str, head: bytes, query: Query, bar: ProgressSink
-) -> _FileResult:
-    if layout not in CSV_LAYOUTS:
-        raise ParameterError(
-            f"--format {layout!r} is not a layout; use one of {', '.join(LAYOUTS)}"
-        )
+def _read_csv(source: Source, layout: str, query: Query, reading: CsvReading) -> _FileResult:
     spec = _csv_layout(layout)
-    header = csv_header(head, layout)
-    missing = [c for c in spec.columns if c not in header.columns]
-    if missing:
-        raise InputFileError(
-            f"{source.name}: the {layout} layout needs the column {missing[0]!r}, which the "
-            f"header does not have; check the file or the --format given"
-        )
     conversion = _Conversion(_csv_conversion(source.name, spec), spec.canonical, spec.static_text)
     result = _FileResult(query, source.name, conversion, layout=layout)
-    with open_data(source, bar) as opened:
-        chunks = read_chunks(
-            opened.stream,
-            header.columns,
-            header.has_header,
-            row_columns=spec.row_columns,
-            all_columns=spec.columns,
-            numeric=spec.numeric,
-            whole=("mmsi",),  # both layouts name it so; a decimal MMSI makes the chunk text
-        )
+    with reading:
         try:
-            with contextlib.closing(chunks):
-                for chunk in chunks:
-                    _csv_chunk(result, spec, chunk)
+            for chunk in reading.chunks():
+                _csv_chunk(result, spec, chunk)
             result.settle()
         except NotUtf8:
             raise _non_utf8_error(source) from None
@@ -483,7 +469,7 @@ def _read_csv(
             raise InputFileError(
                 f"{source.name}: cannot read the CSV ({exc}); check the file"
             ) from None
-        result.sha256 = opened.finish()
+        result.sha256 = reading.finish()
     if result.ledger.rows_read == 0:
         raise InputFileError(
             f"{source.name}: no data rows after the header; give a file with AIS rows"

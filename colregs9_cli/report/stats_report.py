@@ -1,6 +1,6 @@
 """The reports of ``colregs9 stats``: CSV, Markdown (the paper's table), histograms, run.json.
 
-Every file is written atomically. The statistics themselves come from ``colregs9_cli.stats``;
+Every file is written atomically. The statistics themselves come from ``colregs9_cli.dimensions``;
 this module only lays them out.
 """
 
@@ -19,8 +19,8 @@ from .manifest import inputs_manifest, query_manifest, run_header
 
 if TYPE_CHECKING:
     from ..ais.load import AisData
+    from ..dimensions import StatsResult, StatsTable
     from ..query import Query
-    from ..stats import StatsResult, StatsTable
 
 CSV_NAME = "dimension_stats.csv"
 MARKDOWN_NAME = "dimension_stats.md"
