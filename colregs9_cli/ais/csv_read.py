@@ -25,8 +25,9 @@ from .csv_chunks import CsvChunk, read_chunks
 from .detect import CSV_LAYOUTS, CsvHeader, csv_header, detect_layout
 from .sources import OpenedData, Source, inspect_source, open_data, read_head
 
-# How many parsed chunks may wait for the caller (about 25 MB each, bytes and row columns).
-AHEAD_CHUNKS = 8
+# How many parsed chunks may wait for the caller (about 25 MB each, bytes and row columns);
+# 4, 8 and 12 measured alike.
+AHEAD_CHUNKS = 4
 _POLL_S = 0.05
 
 
