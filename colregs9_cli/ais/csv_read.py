@@ -185,8 +185,9 @@ class CsvReading:
         return self._exits.__exit__(kind, error, trace)
 
 
-def open_csv(source: Source, layout: str, head: bytes, progress: ProgressSink) -> CsvReading:
-    return CsvReading(source, layout, csv_header(head, layout), progress)
+def missing_columns(layout: str, header: CsvHeader) -> list[str]:
+    """The columns the layout reads that the header lacks, in the layout's order."""
+    return [c for c in csv_columns(layout).columns if c not in header.columns]
 
 
 @contextlib.contextmanager
@@ -200,7 +201,7 @@ def start_reading(paths: Sequence[Path], fmt: str | None) -> Iterator[CsvReading
             head = read_head(source)
             layout = fmt if fmt is not None else detect_layout(source, head)
             header = csv_header(head, layout) if layout in CSV_LAYOUTS else None
-            if header is not None and set(csv_columns(layout).columns) <= set(header.columns):
+            if header is not None and not missing_columns(layout, header):
                 reading = CsvReading(source, layout, header, None, ahead=True)
     if reading is None:
         yield None

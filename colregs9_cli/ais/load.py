@@ -77,7 +77,7 @@ from .clean import (
     valid_mmsi,
 )
 from .csv_chunks import CsvChunk, CutRows, NotUtf8, ParsedRows, parse_cut_rows
-from .csv_read import CsvReading, csv_columns, open_csv
+from .csv_read import CsvReading, missing_columns
 from .detect import CSV_LAYOUTS, LAYOUTS, csv_header, detect_layout
 from .ledger import RejectReason, RejectsLedger
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
@@ -193,13 +193,8 @@ Example = Callable[[int, str, str], str]
 _Part: TypeAlias = CutRows | pa.Table
 
 
-@dataclass(frozen=True)
-class _StaticText:
-    """Tells the rows without a position that carry static text (a static report) from
-    those that carry nothing, by reading ``columns``."""
-
-    columns: tuple[str, ...]
-    present: Callable[[pa.Table], np.ndarray]
+# Tells, of rows without a position, which carry static text (a static report).
+_StaticText = Callable[[pa.Table], np.ndarray]
 
 
 @dataclass(frozen=True)
@@ -271,7 +266,7 @@ class _FileResult:
         static text, else rejected."""
         static_text = self.conversion.static_text
         assert static_text is not None, "rows are set aside as static only with static text"
-        present = static_text.present(part.table)
+        present = static_text(part.table)
         self.ledger.use(int(present.sum()))
         absent = np.flatnonzero(~present)
         reason = RejectReason.NO_POSITION
@@ -406,13 +401,13 @@ def _read_source(
             f"--format {layout!r} is not a layout; use one of {', '.join(LAYOUTS)}"
         )
     header = csv_header(head, layout)
-    missing = [c for c in csv_columns(layout).columns if c not in header.columns]
+    missing = missing_columns(layout, header)
     if missing:
         raise InputFileError(
             f"{source.name}: the {layout} layout needs the column {missing[0]!r}, which the "
             f"header does not have; check the file or the --format given"
         )
-    return _read_csv(source, layout, query, open_csv(source, layout, head, bar))
+    return _read_csv(source, layout, query, CsvReading(source, layout, header, bar))
 
 
 @dataclass(frozen=True)
@@ -428,7 +423,7 @@ def _csv_layout(layout: str) -> _CsvLayout:
         abcd = layout == "dma26"
         return _CsvLayout(
             fields=lambda b: dma.dma_fields(b, abcd),
-            static_text=_StaticText(dma.STATIC_TEXT_COLUMNS, dma.dma_static_text),
+            static_text=dma.dma_static_text,
             canonical=lambda b: dma.dma_canonical(b, abcd),
             example_columns={
                 "MMSI": "mmsi",
@@ -440,9 +435,7 @@ def _csv_layout(layout: str) -> _CsvLayout:
         )
     return _CsvLayout(
         fields=marinecadastre.marinecadastre_fields,
-        static_text=_StaticText(
-            marinecadastre.STATIC_COLUMNS, marinecadastre.marinecadastre_static_text
-        ),
+        static_text=marinecadastre.marinecadastre_static_text,
         canonical=marinecadastre.marinecadastre_canonical,
         example_columns={
             "MMSI": "mmsi",
@@ -655,12 +648,9 @@ def _canonical_identity(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
 
 def _canonical_static_text(table: pa.Table) -> np.ndarray:
     present = np.zeros(table.num_rows, dtype=bool)
-    for column in _CANONICAL_STATIC.columns:
+    for column in ("ship_type", "name", "callsign", "imo"):
         present |= np.asarray(table.column(column).is_valid().to_numpy(zero_copy_only=False))
     return present
-
-
-_CANONICAL_STATIC = _StaticText(("ship_type", "name", "callsign", "imo"), _canonical_static_text)
 
 
 def _table_example(name: str, table: pa.Table) -> Example:
@@ -727,7 +717,7 @@ def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResul
         raise InputFileError(
             f"{source.name}: a compressed Parquet file; give the .parquet file itself"
         )
-    conversion = _table_conversion(source.name, _CANONICAL_STATIC)
+    conversion = _table_conversion(source.name, _canonical_static_text)
     result = _FileResult(query, source.name, conversion, layout="parquet")
     try:
         parquet = pq.ParquetFile(source.path)

@@ -70,8 +70,6 @@ NUMERIC_COLUMNS = (
 )
 DIMENSION_COLUMNS = ("length", "width", "draft")
 STATIC_TEXT_COLUMNS = ("vesselname", "callsign", "imo")
-# What ``marinecadastre_static_text`` reads.
-STATIC_COLUMNS = ("vesseltype", *STATIC_TEXT_COLUMNS)
 _OTHER = "Other"
 
 
