@@ -12,6 +12,7 @@ import typer
 
 from . import __version__
 from .errors import Colregs9Error
+from .quick_exit import run_and_exit
 
 app = typer.Typer(
     name="colregs9",
@@ -365,3 +366,8 @@ def demo_command(
     with _user_errors():
         result = run_demo(out, quiet=quiet, scenarios_dir=scenarios, chart=chart, query=query)
     typer.echo(result.text, nl=False)
+
+
+def run() -> None:
+    """The ``colregs9`` console script: the app, then a quick exit (see ``quick_exit``)."""
+    run_and_exit(app)

@@ -3,7 +3,8 @@
 
 The first input starts being read before pandas and matplotlib are imported: their import
 takes about a second on one core, and the CSV parse takes the other meanwhile
-(``ais.csv_read.start_reading``). So this module imports them only inside ``run_stats``.
+(``ais.csv_read.start_reading``). So this module imports them, and everything else the
+reading does not need (shapely, ``pyarrow.compute``), only inside ``run_stats``.
 """
 
 from __future__ import annotations
@@ -16,7 +17,6 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 from .ais.csv_read import start_reading
 from .errors import ParameterError
-from .query import everything_query, load_query
 
 if TYPE_CHECKING:
     from .dimensions import GroupBy, Per, StatsResult
@@ -61,8 +61,10 @@ def run_stats(
     Raises ``NoDataError`` (exit code 3) when the query selects no rows, and the other
     ``Colregs9Error`` subclasses for bad input files, queries or options.
     """
-    query = load_query(query_path) if query_path is not None else everything_query()
     with start_reading(paths, fmt) as started:
+        from .query import everything_query, load_query
+
+        query = load_query(query_path) if query_path is not None else everything_query()
         from .ais.load import load_ais
         from .dimensions import GroupBy, Per, dimension_stats
         from .report.stats_report import build_manifest, format_text, write_stats_reports

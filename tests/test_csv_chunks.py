@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from colregs9_cli.ais import csv_chunks, dma, load
+from colregs9_cli.ais import columns, csv_chunks, load
 from colregs9_cli.ais.load import AisData, load_ais
 from colregs9_cli.errors import InputFileError
 from colregs9_cli.query import Query, Region, load_query
@@ -62,6 +62,52 @@ def test_any_chunk_size_reads_the_same(
     whole = load_ais([fixture])
     monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
     _same(load_ais([fixture]), whole)
+
+
+@pytest.mark.parametrize("workers", [1, 3])
+def test_chunks_parsed_side_by_side_come_in_file_order(
+    monkeypatch: pytest.MonkeyPatch, workers: int
+) -> None:
+    """One worker or several, small chunks give the rows, counts and line numbers of one
+    whole chunk."""
+    whole = load_ais([DMA26])
+    monkeypatch.setattr(csv_chunks, "parse_workers", lambda: workers)
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", 300)
+    chunks = _chunks_of(DMA26)
+    assert len(chunks) > 10
+    assert [chunk.line_of(0) for chunk in chunks] == sorted({c.line_of(0) for c in chunks})
+    _same(load_ais([DMA26]), whole)
+
+
+def test_parse_workers_follow_the_cores(monkeypatch: pytest.MonkeyPatch) -> None:
+    """One per core, up to the blocks of a chunk (16 MB in 4 MB blocks: 4)."""
+    for cores, workers in ((1, 1), (2, 2), (4, 4), (16, 4)):
+        monkeypatch.setattr(csv_chunks.pa, "cpu_count", lambda cores=cores: cores)
+        assert csv_chunks.parse_workers() == workers
+
+
+def test_a_decimal_in_a_whole_number_column_is_read_as_it_is(tmp_path: Path) -> None:
+    """DMA lengths and widths are read as integers; a decimal one makes its chunk text and
+    keeps its value."""
+    lines = DMA26.read_text().splitlines()
+    header = lines[0].lower().lstrip("# ").split(",")
+    width, length = header.index("width"), header.index("length")
+    a, b = header.index("a"), header.index("b")
+    row = next(i for i, line in enumerate(lines[1:], 1) if line.split(",")[length])
+    fields = lines[row].split(",")
+    fields[length], fields[a], fields[b] = "12.5", "", ""
+    fields[width] = "4.25"
+    lines[row] = ",".join(fields)
+    path = tmp_path / "decimal.csv"
+    path.write_text("\n".join(lines) + "\n")
+    chunks = _chunks_of(path)
+    assert [chunk.text for chunk in chunks] == [True]
+    positions = load_ais([path]).positions
+    mmsi = int(fields[header.index("mmsi")])
+    vessel = positions[positions["mmsi"] == mmsi]
+    assert 12.5 in vessel["length_m"].to_list()
+    plain = load_ais([DMA26])
+    assert len(positions) == len(plain.positions)
 
 
 @settings(
@@ -222,9 +268,10 @@ def _chunks_of(path: Path) -> list[csv_chunks.CsvChunk]:
                 stream,
                 names,
                 True,
-                row_columns=dma.row_columns(True),
-                all_columns=dma.read_columns(True),
-                numeric=dma.NUMERIC_COLUMNS,
+                row_columns=columns.dma_row_columns(True),
+                all_columns=columns.dma_read_columns(True),
+                numeric=columns.DMA_NUMERIC_COLUMNS,
+                whole=columns.DMA_WHOLE_COLUMNS,
             )
         )
 
@@ -232,8 +279,8 @@ def _chunks_of(path: Path) -> list[csv_chunks.CsvChunk]:
 def test_a_bad_row_costs_its_chunk_not_the_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """Text in a number column makes only its chunk text; a malformed row makes only its
-    chunk parse again on one thread."""
+    """Text in a number column makes only its chunk parse again, as text; a malformed row
+    is skipped with its line number, without a second parse (chunks parse on one thread)."""
     lines = DMA26.read_text().splitlines()
     lines[3] = lines[3].replace("57.459803", "north")  # file line 4
     lines[15] = lines[15] + ",extra"  # file line 16
@@ -254,7 +301,7 @@ def test_a_bad_row_costs_its_chunk_not_the_file(
     assert sum(text) == 1 and text[first_lines.index(max(n for n in first_lines if n <= 4))]
     invalid = [bad.line for chunk in chunks for bad in chunk.invalid_rows]
     assert invalid == [16]
-    assert parses.count(False) == 1  # only the chunk with line 16, on one thread
+    assert parses == [False] * (len(chunks) + 1)  # the chunk with line 4 twice
     assert len(chunks) > 5
 
 

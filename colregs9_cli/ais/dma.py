@@ -37,62 +37,10 @@ from .clean import (
     positive_or_nan,
     whole_positive,
 )
+from .columns import DMA_ABCD, DMA_STATIC_TEXT_COLUMNS, dma_dimension_columns
 from .schema import CANONICAL_SCHEMA
 
 DMA_TIME_FORMAT = "%d/%m/%Y %H:%M:%S"
-# Columns read (DMA names, lower case); the rest of the file is skipped by the CSV reader.
-READ_COLUMNS = (
-    "timestamp",
-    "type of mobile",
-    "mmsi",
-    "latitude",
-    "longitude",
-    "navigational status",
-    "rot",
-    "sog",
-    "cog",
-    "heading",
-    "imo",
-    "callsign",
-    "name",
-    "ship type",
-    "width",
-    "length",
-    "draught",
-)
-ABCD = ("a", "b", "c", "d")
-# Columns read as numbers; a chunk with text in one of them is parsed again with every
-# column as text (see csv_chunks.py).
-NUMERIC_COLUMNS = (
-    "mmsi",
-    "latitude",
-    "longitude",
-    "rot",
-    "sog",
-    "cog",
-    "heading",
-    "width",
-    "length",
-    "draught",
-    *ABCD,
-)
-STATIC_TEXT_COLUMNS = ("ship type", "name", "callsign", "imo")
-
-
-# Columns ``dma_fields`` reads: converted for every row, the others only for the rows kept.
-ROW_COLUMNS = ("type of mobile", "mmsi", "latitude", "longitude", "width", "length", "draught")
-
-
-def read_columns(has_abcd: bool) -> tuple[str, ...]:
-    return (*READ_COLUMNS, *ABCD) if has_abcd else READ_COLUMNS
-
-
-def row_columns(has_abcd: bool) -> tuple[str, ...]:
-    return (*ROW_COLUMNS, *ABCD) if has_abcd else ROW_COLUMNS
-
-
-def dimension_columns(has_abcd: bool) -> tuple[str, ...]:
-    return ("width", "length", "draught", *ABCD) if has_abcd else ("width", "length", "draught")
 
 
 def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
@@ -101,7 +49,7 @@ def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
     length, _ = float_column(batch.column("length"))
     draught, _ = float_column(batch.column("draught"))
     if has_abcd:
-        a, b, c, d = (float_column(batch.column(k))[0] for k in ABCD)
+        a, b, c, d = (float_column(batch.column(k))[0] for k in DMA_ABCD)
         return dimension(a, b, length), dimension(c, d, width), positive_or_nan(draught)
     return positive_or_nan(length), positive_or_nan(width), positive_or_nan(draught)
 
@@ -111,7 +59,7 @@ def dma_fields(batch: pa.RecordBatch, has_abcd: bool) -> Fields:
     lat, bad_lat = float_column(batch.column("latitude"))
     lon, bad_lon = float_column(batch.column("longitude"))
     unparseable, problem = number_problems(bad_mmsi, bad_lat, bad_lon)
-    dimensions = batch.select(list(dimension_columns(has_abcd)))
+    dimensions = batch.select(list(dma_dimension_columns(has_abcd)))
     return Fields(
         mmsi=mmsi,
         lat_deg=null_outside(lat, -90.0, 90.0),
@@ -135,7 +83,7 @@ def _is_vessel(mobile_type: pa.Array) -> BoolArray:
 def dma_static_text(batch: pa.RecordBatch) -> BoolArray:
     """Rows that carry a ship type, name, call sign or IMO."""
     present = np.zeros(batch.num_rows, dtype=bool)
-    for column in STATIC_TEXT_COLUMNS:
+    for column in DMA_STATIC_TEXT_COLUMNS:
         valid = pc.is_valid(clean_text(batch.column(column)))
         present |= np.asarray(valid.to_numpy(zero_copy_only=False), dtype=bool)
     return present

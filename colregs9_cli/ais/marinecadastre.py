@@ -33,43 +33,10 @@ from .clean import (
     positive_or_nan,
     whole_positive,
 )
+from .columns import MARINECADASTRE_DIMENSION_COLUMNS as DIMENSION_COLUMNS
+from .columns import MARINECADASTRE_STATIC_TEXT_COLUMNS as STATIC_TEXT_COLUMNS
 from .schema import CANONICAL_SCHEMA
 
-READ_COLUMNS = (
-    "mmsi",
-    "basedatetime",
-    "lat",
-    "lon",
-    "sog",
-    "cog",
-    "heading",
-    "vesselname",
-    "imo",
-    "callsign",
-    "vesseltype",
-    "status",
-    "length",
-    "width",
-    "draft",
-    "transceiverclass",
-)
-# Columns ``marinecadastre_fields`` reads: converted for every row.
-ROW_COLUMNS = ("mmsi", "lat", "lon", "transceiverclass", "length", "width", "draft")
-NUMERIC_COLUMNS = (
-    "mmsi",
-    "lat",
-    "lon",
-    "sog",
-    "cog",
-    "heading",
-    "vesseltype",
-    "status",
-    "length",
-    "width",
-    "draft",
-)
-DIMENSION_COLUMNS = ("length", "width", "draft")
-STATIC_TEXT_COLUMNS = ("vesselname", "callsign", "imo")
 _OTHER = "Other"
 
 

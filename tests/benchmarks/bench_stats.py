@@ -3,24 +3,27 @@
 Generates DMA 26-column CSVs (default 2.5 M and 5 M rows) in a temporary directory, then,
 on the same file in the same run, times each tool in its own subprocess:
 
-- ``colregs9 stats``: the whole command (read, filter, statistics, four report files);
+- ``colregs9 stats``: the whole command as users run it, the console script of this venv
+  (start-up, read, filter, statistics, the four report files, exit);
 - ``colregs9 load_ais``: only the streaming read and query filter behind it;
 - ``polars``: ``scan_csv(...).filter(box).collect()``;
 - ``duckdb``: ``SELECT * FROM read_csv(...) WHERE box``.
 
-Wall time is measured by the parent around the subprocess (interpreter start and imports
-included, the same for all). The tools take turns ``--repeat`` times (rounds, round-robin, so
+Wall time is measured by the parent around the subprocess (interpreter start, imports and
+exit included, the same for all). The tools take turns ``--repeat`` times (rounds, round-robin, so
 that a slow spell of the machine hits all of them). Reported per tool: its fastest run (the
 usual choice on a machine shared with other work) and its median run, and the median over
 rounds of its time over the fastest tool's time in the same round, which is steadier where
 the machine's speed drifts from one minute to the next. CPU time (user + system, all threads) is
 the child's own. Peak RSS is the child's ``VmHWM`` from ``/proc/self/status`` at exit:
 unlike ``ru_maxrss``, which Linux carries over from the parent across fork and exec, it starts
-afresh in the new process, so each figure belongs to one tool. The files are generated in a
+afresh in the new process, so each figure belongs to one tool. The console script is timed
+from this (small) parent process instead: its CPU time and ``ru_maxrss`` come from
+``os.wait4``, and what it selected from its ``run.json``. The files are generated in a
 subprocess too. Every tool reports the rows and vessels it selected, so that the results can
 be seen to agree.
 
-Usage: python tests/benchmarks/bench_stats.py [--sizes 2500000 5000000] [--repeat 3]
+Usage: python tests/benchmarks/bench_stats.py [--sizes 2500000 5000000] [--repeat 3] [--csv FILE]
 Needs the ``bench`` extra (polars, duckdb).
 """
 
@@ -53,11 +56,6 @@ def _box() -> tuple[float, float, float, float]:
 def _run_tool(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
     """Run one tool in this (child) process; returns what it selected."""
     lat_min, lat_max, lon_min, lon_max = _box()
-    if tool == "colregs9 stats":
-        from colregs9_cli.stats import run_stats
-
-        run = run_stats([csv_path], query_path=QUERY, out_dir=out_dir, quiet=True)
-        return {"rows": run.manifest["rows_in_query"], "vessels": run.result.vessels}
     if tool == "colregs9 load_ais":
         from colregs9_cli.ais.load import load_ais
         from colregs9_cli.query import load_query
@@ -102,10 +100,45 @@ def _child(tool: str, csv_path: Path, out_dir: Path) -> None:
     print(json.dumps({**selected, "peak_rss_mb": _peak_rss_mb(), "cpu_s": cpu_s}))
 
 
-def _measure(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
+def _environment() -> dict[str, str]:
     # Cached bytecode, as on a user's machine: PYTHONDONTWRITEBYTECODE (set on some CI and
     # sandbox images) would have colregs9's own modules compiled again in every run.
-    environment = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    return {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+
+
+def _measure_console_script(csv_path: Path, out_dir: Path) -> dict[str, Any]:
+    script = Path(sys.executable).with_name("colregs9")
+    if not script.exists():
+        raise SystemExit(f"no console script {script}; install the project in this venv")
+    command = [str(script), "stats", str(csv_path), "--query", str(QUERY), "--out", str(out_dir)]
+    started = time.perf_counter()
+    child = subprocess.Popen(
+        [*command, "--quiet"],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        env=_environment(),
+    )
+    _, status, usage = os.wait4(child.pid, 0)
+    wall_s = time.perf_counter() - started
+    assert child.stderr is not None
+    errors = child.stderr.read().decode(errors="replace")
+    child.stderr.close()
+    if os.waitstatus_to_exitcode(status) != 0:
+        raise SystemExit(f"colregs9 stats failed on {csv_path}:\n{errors}")
+    manifest = json.loads((out_dir / "run.json").read_text(encoding="utf-8"))
+    return {
+        "rows": manifest["rows_in_query"],
+        "vessels": manifest["vessels"],
+        "peak_rss_mb": usage.ru_maxrss / 1024,  # kB
+        "cpu_s": usage.ru_utime + usage.ru_stime,
+        "wall_s": wall_s,
+    }
+
+
+def _measure(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
+    if tool == "colregs9 stats":
+        return _measure_console_script(csv_path, out_dir)
+    environment = _environment()
     started = time.perf_counter()
     completed = subprocess.run(
         [sys.executable, __file__, "--child", tool, str(csv_path), str(out_dir)],
@@ -120,11 +153,21 @@ def _measure(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
     return {**json.loads(completed.stdout.strip().splitlines()[-1]), "wall_s": wall_s}
 
 
+def _data_rows(csv_path: Path) -> int:
+    with csv_path.open("rb") as stream:
+        return sum(block.count(b"\n") for block in iter(lambda: stream.read(1 << 24), b"")) - 1
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[2_500_000, 5_000_000])
     parser.add_argument("--repeat", type=int, default=3, help="rounds of runs (round-robin)")
     parser.add_argument("--keep", action="store_true", help="keep the generated files")
+    parser.add_argument(
+        "--csv",
+        type=Path,
+        help="time this DMA 26-column CSV (made by gen_dma_csv.py) instead of generating files",
+    )
     parser.add_argument("--child", nargs=3, metavar=("TOOL", "CSV", "OUT"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
@@ -133,17 +176,20 @@ def main() -> None:
         return
 
     generator = Path(__file__).with_name("gen_dma_csv.py")
+    # A given file: its data rows (the header line aside).
+    sizes = args.sizes if args.csv is None else [_data_rows(args.csv)]
     workdir = Path(tempfile.mkdtemp(prefix="colregs9-bench-"))
     print(f"box {_box()} from {QUERY.relative_to(ROOT)}; files in {workdir}")
     results: list[dict[str, Any]] = []
     try:
-        for rows in args.sizes:
-            csv_path = workdir / f"aisdk_{rows}.csv"
-            subprocess.run(
-                [sys.executable, str(generator), "--rows", str(rows), "--out", str(csv_path)],
-                check=True,
-                stdout=subprocess.DEVNULL,
-            )
+        for rows in sizes:
+            csv_path = args.csv if args.csv is not None else workdir / f"aisdk_{rows}.csv"
+            if args.csv is None:
+                subprocess.run(
+                    [sys.executable, str(generator), "--rows", str(rows), "--out", str(csv_path)],
+                    check=True,
+                    stdout=subprocess.DEVNULL,
+                )
             size_mb = csv_path.stat().st_size / 1e6
             print(f"\n{rows:,} rows, {size_mb:,.0f} MB")
             # Round-robin, so that a slow spell of the machine hits every tool alike.
@@ -178,7 +224,8 @@ def main() -> None:
                     f"  cpu {result['cpu_s']:6.2f} s  {result['peak_rss_mb']:7.0f} MB"
                     f"  rows {result['rows']:,}  vessels {result['vessels']:,}"
                 )
-            csv_path.unlink()
+            if args.csv is None:
+                csv_path.unlink()
     finally:
         if not args.keep:
             shutil.rmtree(workdir, ignore_errors=True)
@@ -188,7 +235,7 @@ def main() -> None:
         "| × round's fastest (median) | CPU time | peak RSS | rows selected | vessels |"
     )
     print("|--:|--:|:--|--:|--:|--:|--:|--:|--:|--:|--:|")
-    for rows in args.sizes:
+    for rows in sizes:
         at_size = [r for r in results if r["rows_in_file"] == rows]
         fastest = min(r["wall_s"] for r in at_size)
         for r in at_size:

@@ -1,0 +1,140 @@
+"""The columns each CSV layout reads, and how they are read.
+
+A light module (no ``pyarrow.compute``, pandas or shapely): ``colregs9 stats`` starts reading
+its first CSV before it imports those (``csv_read.start_reading``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# -- DMA "aisdk" (lower-case names) -------------------------------------------------------------
+
+# Columns read; the rest of the file is skipped by the CSV reader.
+DMA_READ_COLUMNS = (
+    "timestamp",
+    "type of mobile",
+    "mmsi",
+    "latitude",
+    "longitude",
+    "navigational status",
+    "rot",
+    "sog",
+    "cog",
+    "heading",
+    "imo",
+    "callsign",
+    "name",
+    "ship type",
+    "width",
+    "length",
+    "draught",
+)
+DMA_ABCD = ("a", "b", "c", "d")
+# Columns read as numbers; a chunk with text in one of them is parsed again with every
+# column as text (see csv_chunks.py).
+DMA_NUMERIC_COLUMNS = (
+    "mmsi",
+    "latitude",
+    "longitude",
+    "rot",
+    "sog",
+    "cog",
+    "heading",
+    "width",
+    "length",
+    "draught",
+    *DMA_ABCD,
+)
+# Of those, the ones DMA writes as whole numbers (metres), read as integers: about 5 % faster
+# to parse than decimals. A decimal in one makes its chunk text, as any other bad number.
+DMA_WHOLE_COLUMNS = ("mmsi", "width", "length", *DMA_ABCD)
+DMA_STATIC_TEXT_COLUMNS = ("ship type", "name", "callsign", "imo")
+# Converted for every row; the others only for the rows kept.
+DMA_ROW_COLUMNS = ("type of mobile", "mmsi", "latitude", "longitude", "width", "length", "draught")
+
+
+def dma_read_columns(has_abcd: bool) -> tuple[str, ...]:
+    return (*DMA_READ_COLUMNS, *DMA_ABCD) if has_abcd else DMA_READ_COLUMNS
+
+
+def dma_row_columns(has_abcd: bool) -> tuple[str, ...]:
+    return (*DMA_ROW_COLUMNS, *DMA_ABCD) if has_abcd else DMA_ROW_COLUMNS
+
+
+def dma_dimension_columns(has_abcd: bool) -> tuple[str, ...]:
+    dimensions = ("width", "length", "draught")
+    return (*dimensions, *DMA_ABCD) if has_abcd else dimensions
+
+
+# -- MarineCadastre (lower-case names) --------------------------------------------------------
+
+MARINECADASTRE_READ_COLUMNS = (
+    "mmsi",
+    "basedatetime",
+    "lat",
+    "lon",
+    "sog",
+    "cog",
+    "heading",
+    "vesselname",
+    "imo",
+    "callsign",
+    "vesseltype",
+    "status",
+    "length",
+    "width",
+    "draft",
+    "transceiverclass",
+)
+# Converted for every row.
+MARINECADASTRE_ROW_COLUMNS = ("mmsi", "lat", "lon", "transceiverclass", "length", "width", "draft")
+MARINECADASTRE_NUMERIC_COLUMNS = (
+    "mmsi",
+    "lat",
+    "lon",
+    "sog",
+    "cog",
+    "heading",
+    "vesseltype",
+    "status",
+    "length",
+    "width",
+    "draft",
+)
+# MarineCadastre writes its dimensions as decimals ("208.0").
+MARINECADASTRE_WHOLE_COLUMNS = ("mmsi",)
+MARINECADASTRE_DIMENSION_COLUMNS = ("length", "width", "draft")
+MARINECADASTRE_STATIC_TEXT_COLUMNS = ("vesselname", "callsign", "imo")
+
+
+@dataclass(frozen=True)
+class CsvColumns:
+    """What the chunk reader converts: ``row_columns`` for every row, ``columns`` for the
+    rows taken; ``numeric`` are read as numbers, those also in ``whole`` as integers."""
+
+    columns: tuple[str, ...]
+    row_columns: tuple[str, ...]
+    numeric: tuple[str, ...]
+    whole: tuple[str, ...]
+
+
+def csv_columns(layout: str) -> CsvColumns:
+    if layout in ("dma26", "dma22"):
+        abcd = layout == "dma26"
+
+        def present(names: tuple[str, ...]) -> tuple[str, ...]:
+            return tuple(c for c in names if abcd or c not in DMA_ABCD)
+
+        return CsvColumns(
+            dma_read_columns(abcd),
+            dma_row_columns(abcd),
+            present(DMA_NUMERIC_COLUMNS),
+            present(DMA_WHOLE_COLUMNS),
+        )
+    return CsvColumns(
+        MARINECADASTRE_READ_COLUMNS,
+        MARINECADASTRE_ROW_COLUMNS,
+        MARINECADASTRE_NUMERIC_COLUMNS,
+        MARINECADASTRE_WHOLE_COLUMNS,
+    )

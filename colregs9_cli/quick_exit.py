@@ -1,0 +1,50 @@
+"""Leaving the process once a command is done, without tearing the interpreter down.
+
+A normal exit finalises the interpreter: it frees every object of pandas, matplotlib and
+pyarrow one by one, which takes 0.15-0.2 s after every run, once all the work is done. The
+console script therefore flushes the standard streams and leaves with ``os._exit``, as mypy
+does by default (``mypy.util.hard_exit``). Nothing is lost: every command closes the files it
+writes (atomically) and joins its threads before it returns.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from collections.abc import Callable
+from typing import NoReturn
+
+# What CPython exits with when it cannot flush stdout at exit (e.g. a closed pipe).
+_UNFLUSHED_STATUS = 120
+
+
+def exit_status(exit_: SystemExit) -> int:
+    """The status ``sys.exit`` would give; a message is printed to stderr, as it would be."""
+    code = exit_.code
+    if code is None:
+        return 0
+    if isinstance(code, int):
+        return code
+    print(code, file=sys.stderr)
+    return 1
+
+
+def flush_streams(status: int) -> int:
+    """Flush stdout and stderr; ``status``, or 120 if it was 0 and a stream would not flush."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            status = status or _UNFLUSHED_STATUS
+    return status
+
+
+def run_and_exit(main: Callable[[], object]) -> NoReturn:
+    """Run ``main`` (a Click or Typer app, which ends with ``SystemExit``), then leave at once
+    with its status. Any other exception propagates, with its traceback, as usual."""
+    try:
+        main()
+        status = 0
+    except SystemExit as exit_:
+        status = exit_status(exit_)
+    os._exit(flush_streams(status))

@@ -1,0 +1,101 @@
+"""The console script's quick exit: the statuses of ``sys.exit``, streams flushed, files whole."""
+
+from __future__ import annotations
+
+import io
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from colregs9_cli import quick_exit
+
+ROOT = Path(__file__).resolve().parents[1]
+DMA26 = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
+
+
+class _Left(Exception):
+    """Stands in for ``os._exit`` in the tests, which must not end pytest."""
+
+
+def _exit_status(main: object, monkeypatch: pytest.MonkeyPatch) -> int:
+    statuses: list[int] = []
+
+    def leave(status: int) -> None:
+        statuses.append(status)
+        raise _Left
+
+    monkeypatch.setattr(quick_exit.os, "_exit", leave)
+    with pytest.raises(_Left):
+        quick_exit.run_and_exit(main)  # type: ignore[arg-type]
+    return statuses[0]
+
+
+@pytest.mark.parametrize(("code", "status"), [(None, 0), (0, 0), (2, 2), (3, 3), ("Error: bad", 1)])
+def test_the_status_is_that_of_sys_exit(
+    code: object, status: int, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    def main() -> None:
+        sys.exit(code)  # type: ignore[arg-type]
+
+    assert _exit_status(main, monkeypatch) == status
+    assert capsys.readouterr().err == ("Error: bad\n" if isinstance(code, str) else "")
+
+
+def test_a_main_that_returns_exits_0(monkeypatch: pytest.MonkeyPatch) -> None:
+    assert _exit_status(lambda: None, monkeypatch) == 0
+
+
+def test_other_exceptions_propagate_with_their_traceback(monkeypatch: pytest.MonkeyPatch) -> None:
+    def main() -> None:
+        raise ValueError("a bug")
+
+    monkeypatch.setattr(quick_exit.os, "_exit", lambda status: pytest.fail("left quickly"))
+    with pytest.raises(ValueError, match="a bug"):
+        quick_exit.run_and_exit(main)
+
+
+def test_an_unflushable_stdout_gives_120_unless_already_failing(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    class Closed(io.StringIO):
+        def flush(self) -> None:
+            raise BrokenPipeError
+
+    monkeypatch.setattr(sys, "stdout", Closed())
+    assert quick_exit.flush_streams(0) == 120
+    assert quick_exit.flush_streams(3) == 3
+
+
+def _run(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """The console script's entry point in a fresh interpreter."""
+    code = "import sys; from colregs9_cli.cli import run; sys.argv[0] = 'colregs9'; run()"
+    return subprocess.run(
+        [sys.executable, "-c", code, *args], capture_output=True, text=True, cwd=cwd, check=False
+    )
+
+
+def test_the_console_script_writes_everything_before_it_leaves(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    done = _run("stats", str(DMA26), "--out", str(out), "--quiet", cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    assert "length_m" in done.stdout  # the table, flushed
+    manifest = json.loads((out / "run.json").read_text())
+    assert manifest["rows_read"] == 20
+    assert (out / "dimension_histograms.png").read_bytes().startswith(b"\x89PNG")
+    assert sorted(p.name for p in out.iterdir()) == [
+        "dimension_histograms.png",
+        "dimension_stats.csv",
+        "dimension_stats.md",
+        "run.json",
+    ]
+
+
+def test_the_console_script_keeps_error_lines_and_codes(tmp_path: Path) -> None:
+    done = _run("stats", str(tmp_path / "missing.csv"), cwd=tmp_path)
+    assert done.returncode != 0
+    assert done.stderr.startswith("Error: ") and done.stderr.count("\n") == 1
+    version = _run("--version", cwd=tmp_path)
+    assert version.returncode == 0 and version.stdout.startswith("colregs9 ")
