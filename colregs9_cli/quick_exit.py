@@ -1,4 +1,5 @@
-"""Leaving the process once a command is done, without tearing the interpreter down.
+"""Running the console script: fewer garbage collections, and leaving the process once a
+command is done without tearing the interpreter down.
 
 A normal exit finalises the interpreter: it frees every object of pandas, matplotlib and
 pyarrow one by one, which takes 0.15-0.2 s after every run, once all the work is done. The
@@ -9,6 +10,7 @@ writes (atomically) and joins its threads before it returns.
 
 from __future__ import annotations
 
+import gc
 import os
 import sys
 from collections.abc import Callable
@@ -16,6 +18,11 @@ from typing import NoReturn
 
 # What CPython exits with when it cannot flush stdout at exit (e.g. a closed pipe).
 _UNFLUSHED_STATUS = 120
+# Allocations between two collections of the youngest generation (CPython's default: 700).
+# A command imports pandas, matplotlib and pyarrow: about a million objects that live until
+# the end, which the collector would walk again and again (0.12 s of the 0.96 s those
+# imports take; 0.08 s less with this threshold). Cycles are still collected, less often.
+GC_YOUNG_THRESHOLD = 50_000
 
 
 def exit_status(exit_: SystemExit) -> int:
@@ -42,6 +49,8 @@ def flush_streams(status: int) -> int:
 def run_and_exit(main: Callable[[], object]) -> NoReturn:
     """Run ``main`` (a Click or Typer app, which ends with ``SystemExit``), then leave at once
     with its status. Any other exception propagates, with its traceback, as usual."""
+    _, older, oldest = gc.get_threshold()
+    gc.set_threshold(GC_YOUNG_THRESHOLD, older, oldest)
     try:
         main()
         status = 0

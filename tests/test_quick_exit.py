@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import gc
 import io
 import json
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -14,6 +16,14 @@ from colregs9_cli import quick_exit
 
 ROOT = Path(__file__).resolve().parents[1]
 DMA26 = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
+
+
+@pytest.fixture(autouse=True)
+def _gc_thresholds() -> Iterator[None]:
+    """``run_and_exit`` sets the collector's thresholds for the process: restore pytest's."""
+    thresholds = gc.get_threshold()
+    yield
+    gc.set_threshold(*thresholds)
 
 
 class _Left(Exception):
@@ -46,6 +56,14 @@ def test_the_status_is_that_of_sys_exit(
 
 def test_a_main_that_returns_exits_0(monkeypatch: pytest.MonkeyPatch) -> None:
     assert _exit_status(lambda: None, monkeypatch) == 0
+
+
+def test_the_main_runs_with_fewer_young_collections(monkeypatch: pytest.MonkeyPatch) -> None:
+    _, older, oldest = gc.get_threshold()
+    seen: list[tuple[int, int, int]] = []
+    _exit_status(lambda: seen.append(gc.get_threshold()), monkeypatch)
+    assert seen == [(quick_exit.GC_YOUNG_THRESHOLD, older, oldest)]
+    assert gc.isenabled()
 
 
 def test_other_exceptions_propagate_with_their_traceback(monkeypatch: pytest.MonkeyPatch) -> None:
