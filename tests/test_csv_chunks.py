@@ -79,6 +79,34 @@ def test_chunks_parsed_side_by_side_come_in_file_order(
     _same(load_ais([DMA26]), whole)
 
 
+def test_piece_buffers_are_reused_once_no_chunk_holds_them(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", 300)
+    rows = DMA26.read_bytes().split(b"\n", 1)[1]
+    # Every chunk kept: each has a buffer of its own, and the bytes of the file.
+    chunks = _chunks_of(DMA26)
+    assert len({id(chunk._data.obj) for chunk in chunks}) == len(chunks) > 10
+    assert b"".join(bytes(chunk._data) for chunk in chunks) == rows
+    # Chunks dropped once used: a few buffers serve the whole file, with the same bytes.
+    names = DMA26.read_text().splitlines()[0].lower().lstrip("# ").split(",")
+    buffers, read = set(), []
+    with DMA26.open("rb") as stream:
+        for chunk in csv_chunks.read_chunks(
+            stream,
+            names,
+            True,
+            row_columns=columns.dma_row_columns(True),
+            all_columns=columns.dma_read_columns(True),
+            numeric=columns.DMA_NUMERIC_COLUMNS,
+        ):
+            buffers.add(id(chunk._data.obj))
+            read.append(bytes(chunk._data))
+    assert len(read) == len(chunks)
+    assert len(buffers) <= csv_chunks.parse_workers() + 2
+    assert b"".join(read) == rows
+
+
 def test_parse_workers_follow_the_cores(monkeypatch: pytest.MonkeyPatch) -> None:
     """One per core, up to the blocks of a chunk (16 MB in 4 MB blocks: 4)."""
     for cores, workers in ((1, 1), (2, 2), (4, 4), (16, 4)):
