@@ -26,9 +26,10 @@ from .detect import CSV_LAYOUTS, CsvHeader, csv_header, detect_layout
 from .sources import OpenedData, Source, inspect_source, open_data, read_head
 
 # How many parsed chunks may wait for the caller (about 25 MB each, bytes and row columns).
-# The imports of ``colregs9 stats`` take about as long as 12 chunks on the other core: with
-# fewer, the read-ahead stops and a core idles (4: 3.48 s best, 3.56 s median, against
-# 3.39 s and 3.50 s on 5 M rows; peak RSS 480 against 675 MB).
+# The imports of ``colregs9 stats`` take about as long as parsing 12 chunks on the other
+# core; with fewer the read-ahead stops and a core idles (4: 3.48 s best, 3.56 s median,
+# against 3.39 s and 3.50 s for 12, on 5 M rows). Peak RSS 480 against 675 MB, 550 MB for 6,
+# which measured alike with chunks parsed side by side (1.41 and 1.45 × polars, 8 rounds).
 AHEAD_CHUNKS = 12
 _POLL_S = 0.05
 
