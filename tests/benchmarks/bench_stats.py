@@ -10,8 +10,9 @@ on the same file in the same run, times each tool in its own subprocess:
 - ``duckdb``: ``SELECT * FROM read_csv(...) WHERE box``.
 
 Wall time is measured by the parent around the subprocess (interpreter start, imports and
-exit included, the same for all). The tools take turns ``--repeat`` times (rounds, round-robin, so
-that a slow spell of the machine hits all of them). Reported per tool: its fastest run (the
+exit included, the same for all). The tools take turns ``--repeat`` times (rounds,
+round-robin, each round starting with the next tool, so that a slow spell of the machine hits
+all of them and no tool always runs after the same one). Reported per tool: its fastest run (the
 usual choice on a machine shared with other work) and its median run, and the median over
 rounds of its time over the fastest tool's time in the same round, which is steadier where
 the machine's speed drifts from one minute to the next. CPU time (user + system, all threads) is
@@ -153,6 +154,11 @@ def _measure(tool: str, csv_path: Path, out_dir: Path) -> dict[str, Any]:
     return {**json.loads(completed.stdout.strip().splitlines()[-1]), "wall_s": wall_s}
 
 
+def _rotated(tools: tuple[str, ...], by: int) -> tuple[str, ...]:
+    by %= len(tools)
+    return tools[by:] + tools[:by]
+
+
 def _data_rows(csv_path: Path) -> int:
     with csv_path.open("rb") as stream:
         return sum(block.count(b"\n") for block in iter(lambda: stream.read(1 << 24), b"")) - 1
@@ -193,9 +199,10 @@ def main() -> None:
             size_mb = csv_path.stat().st_size / 1e6
             print(f"\n{rows:,} rows, {size_mb:,.0f} MB")
             # Round-robin, so that a slow spell of the machine hits every tool alike.
+            # Each round starts with the next tool, so that no tool always follows another.
             rounds = [
-                {tool: _measure(tool, csv_path, workdir / "out") for tool in TOOLS}
-                for _ in range(args.repeat)
+                {tool: _measure(tool, csv_path, workdir / "out") for tool in _rotated(TOOLS, n)}
+                for n in range(args.repeat)
             ]
             for tool in TOOLS:
                 runs = [measured[tool] for measured in rounds]
