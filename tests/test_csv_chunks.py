@@ -6,6 +6,7 @@ fixture, whose counts tests/test_ais_readers.py checks independently.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import pandas as pd
@@ -89,19 +90,10 @@ def test_piece_buffers_are_reused_once_no_chunk_holds_them(
     assert len({id(chunk._data.obj) for chunk in chunks}) == len(chunks) > 10
     assert b"".join(bytes(chunk._data) for chunk in chunks) == rows
     # Chunks dropped once used: a few buffers serve the whole file, with the same bytes.
-    names = DMA26.read_text().splitlines()[0].lower().lstrip("# ").split(",")
     buffers, read = set(), []
-    with DMA26.open("rb") as stream:
-        for chunk in csv_chunks.read_chunks(
-            stream,
-            names,
-            True,
-            row_columns=columns.dma_row_columns(True),
-            all_columns=columns.dma_read_columns(True),
-            numeric=columns.DMA_NUMERIC_COLUMNS,
-        ):
-            buffers.add(id(chunk._data.obj))
-            read.append(bytes(chunk._data))
+    for chunk in _read_chunks(DMA26):
+        buffers.add(id(chunk._data.obj))
+        read.append(bytes(chunk._data))
     assert len(read) == len(chunks)
     assert len(buffers) <= csv_chunks.parse_workers() + 2
     assert b"".join(read) == rows
@@ -288,20 +280,23 @@ def test_text_in_a_column_converted_only_for_kept_rows(tmp_path: Path) -> None:
     assert data.positions.drop(columns="sog_kn").equals(plain.positions.drop(columns="sog_kn"))
 
 
-def _chunks_of(path: Path) -> list[csv_chunks.CsvChunk]:
+def _read_chunks(path: Path) -> Iterator[csv_chunks.CsvChunk]:
+    """The chunks of a DMA 26-column file, read as ``load_ais`` reads them, one at a time."""
     names = path.read_text().splitlines()[0].lower().lstrip("# ").split(",")
     with path.open("rb") as stream:
-        return list(
-            csv_chunks.read_chunks(
-                stream,
-                names,
-                True,
-                row_columns=columns.dma_row_columns(True),
-                all_columns=columns.dma_read_columns(True),
-                numeric=columns.DMA_NUMERIC_COLUMNS,
-                whole=columns.DMA_WHOLE_COLUMNS,
-            )
+        yield from csv_chunks.read_chunks(
+            stream,
+            names,
+            True,
+            row_columns=columns.dma_row_columns(True),
+            all_columns=columns.dma_read_columns(True),
+            numeric=columns.DMA_NUMERIC_COLUMNS,
+            whole=columns.DMA_WHOLE_COLUMNS,
         )
+
+
+def _chunks_of(path: Path) -> list[csv_chunks.CsvChunk]:
+    return list(_read_chunks(path))
 
 
 def test_a_bad_row_costs_its_chunk_not_the_file(

@@ -8,28 +8,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .detect import DMA22_COLUMNS, MARINECADASTRE_COLUMNS
+
 # -- DMA "aisdk" (lower-case names) -------------------------------------------------------------
 
-# Columns read; the rest of the file is skipped by the CSV reader.
-DMA_READ_COLUMNS = (
-    "timestamp",
-    "type of mobile",
-    "mmsi",
-    "latitude",
-    "longitude",
-    "navigational status",
-    "rot",
-    "sog",
-    "cog",
-    "heading",
-    "imo",
-    "callsign",
-    "name",
-    "ship type",
-    "width",
-    "length",
-    "draught",
+# Header columns the canonical schema has no place for: the CSV reader skips them.
+DMA_UNREAD_COLUMNS = (
+    "cargo type",
+    "type of position fixing device",
+    "destination",
+    "eta",
+    "data source type",
 )
+DMA_READ_COLUMNS = tuple(c for c in DMA22_COLUMNS if c not in DMA_UNREAD_COLUMNS)
 DMA_ABCD = ("a", "b", "c", "d")
 # Columns read as numbers; a chunk with text in one of them is parsed again with every
 # column as text (see csv_chunks.py).
@@ -69,23 +60,9 @@ def dma_dimension_columns(has_abcd: bool) -> tuple[str, ...]:
 
 # -- MarineCadastre (lower-case names) --------------------------------------------------------
 
-MARINECADASTRE_READ_COLUMNS = (
-    "mmsi",
-    "basedatetime",
-    "lat",
-    "lon",
-    "sog",
-    "cog",
-    "heading",
-    "vesselname",
-    "imo",
-    "callsign",
-    "vesseltype",
-    "status",
-    "length",
-    "width",
-    "draft",
-    "transceiverclass",
+MARINECADASTRE_UNREAD_COLUMNS = ("cargo",)
+MARINECADASTRE_READ_COLUMNS = tuple(
+    c for c in MARINECADASTRE_COLUMNS if c not in MARINECADASTRE_UNREAD_COLUMNS
 )
 # Converted for every row.
 MARINECADASTRE_ROW_COLUMNS = ("mmsi", "lat", "lon", "transceiverclass", "length", "width", "draft")
