@@ -5,10 +5,9 @@ from pathlib import Path
 import matplotlib
 import pytest
 
-matplotlib.use("Agg")
+from fixture_files import FIXTURES
 
-ROOT = Path(__file__).resolve().parents[1]
-FIXTURES = ROOT / "fixtures"
+matplotlib.use("Agg")
 
 
 @pytest.fixture(scope="session")

@@ -17,8 +17,8 @@ from shapely.ops import unary_union
 
 from colregs9_cli.geo import LocalFrame
 
-ROOT = Path(__file__).resolve().parents[1]
-CHART = ROOT / "fixtures" / "charts" / "aalborg_modelled.geojson"
+from fixture_files import MODELLED_CHART, ROOT
+
 SCRIPT = ROOT / "scripts" / "make_aalborg_chart.py"
 FRAME = LocalFrame.centred_on(57.044196, 57.062865, 9.909933, 9.971545)  # region R
 
@@ -33,7 +33,7 @@ def _metric(geom: shapely.Geometry) -> shapely.Geometry:
 
 @pytest.fixture(scope="module")
 def chart() -> dict:
-    return json.loads(CHART.read_text(encoding="utf-8"))
+    return json.loads(MODELLED_CHART.read_text(encoding="utf-8"))
 
 
 @pytest.fixture(scope="module")
@@ -173,16 +173,16 @@ def test_depth_bands_by_distance_from_land(
 
 
 def test_file_is_small_and_regenerates_identically(tmp_path: Path) -> None:
-    assert CHART.stat().st_size < 1_000_000
+    assert MODELLED_CHART.stat().st_size < 1_000_000
     out = tmp_path / "chart.geojson"
     subprocess.run([sys.executable, str(SCRIPT), str(out)], check=True, cwd=ROOT)
-    assert out.read_bytes() == CHART.read_bytes()
+    assert out.read_bytes() == MODELLED_CHART.read_bytes()
 
 
 def test_chart_loader_reads_the_modelled_chart() -> None:
     from colregs9_cli.chart import load_chart
 
-    chart = load_chart([CHART], FRAME)
+    chart = load_chart([MODELLED_CHART], FRAME)
     assert chart.depth_range_m() == (0.0, 8.0)
     narrow = _metric(LineString([(9.9250, 57.0490), (9.9250, 57.0590)]))
     wide = _metric(LineString([(9.9550, 57.0750), (9.9950, 57.0750)]))

@@ -14,8 +14,8 @@ from colregs9_cli.ais.load import load_ais
 from colregs9_cli.errors import NoDataError
 from colregs9_cli.query import Query, Region, TimeWindow, VesselFilter, load_query
 
-ROOT = Path(__file__).resolve().parents[1]
-DMA26 = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
+from fixture_files import DMA26, ROOT
+
 HEADER = DMA26.read_text().splitlines()[0]
 
 

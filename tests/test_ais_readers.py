@@ -18,12 +18,7 @@ from colregs9_cli.ais.load import load_ais
 from colregs9_cli.errors import InputFileError, ParameterError
 from colregs9_cli.query import load_query
 
-ROOT = Path(__file__).resolve().parents[1]
-AIS = ROOT / "fixtures" / "ais"
-DMA26 = AIS / "aisdk_2024-09-09_sample.csv"
-DMA22 = AIS / "aisdk_2018-06-01_sample_22col.csv"
-MARINECADASTRE = AIS / "marinecadastre_2023-01-11_sample.csv"
-NMEA = AIS / "dma_nmea_2013-11-12_5min.txt.gz"
+from fixture_files import DMA22, DMA26, MARINECADASTRE, NMEA, ROOT
 
 
 def row_of(data, mmsi: int) -> pd.Series:

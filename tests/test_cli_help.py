@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import re
-from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
 
-ROOT = Path(__file__).resolve().parents[1]
+from fixture_files import ROOT
 
 
 def _command_names() -> list[str]:

@@ -19,11 +19,7 @@ from colregs9_cli.ais.load import AisData, load_ais
 from colregs9_cli.errors import InputFileError
 from colregs9_cli.query import Query, Region, load_query
 
-ROOT = Path(__file__).resolve().parents[1]
-DMA26 = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
-MARINECADASTRE = ROOT / "fixtures" / "ais" / "marinecadastre_2023-01-11_sample.csv"
-DMA22 = ROOT / "fixtures" / "ais" / "aisdk_2018-06-01_sample_22col.csv"
-NMEA = ROOT / "fixtures" / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
+from fixture_files import DMA22, DMA26, MARINECADASTRE, NMEA
 
 
 def _counts(data: AisData) -> dict[str, object]:

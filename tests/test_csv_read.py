@@ -17,12 +17,7 @@ from colregs9_cli.ais.load import AisData, load_ais
 from colregs9_cli.errors import InputFileError
 from colregs9_cli.query import Query, Region
 
-ROOT = Path(__file__).resolve().parents[1]
-AIS = ROOT / "fixtures" / "ais"
-DMA26 = AIS / "aisdk_2024-09-09_sample.csv"
-DMA22 = AIS / "aisdk_2018-06-01_sample_22col.csv"
-MARINECADASTRE = AIS / "marinecadastre_2023-01-11_sample.csv"
-NMEA = AIS / "dma_nmea_2013-11-12_5min.txt.gz"
+from fixture_files import AIS_FIXTURES, DMA22, DMA26, MARINECADASTRE, NMEA
 
 
 def _read_ahead(paths: list[Path], query: Query | None = None) -> AisData:
@@ -96,7 +91,7 @@ def test_stopping_before_the_chunks_are_taken_ends_the_thread(
     assert not _ahead_threads()
 
 
-@pytest.mark.parametrize("path", [NMEA, AIS / "no_such_file.csv"])
+@pytest.mark.parametrize("path", [NMEA, AIS_FIXTURES / "no_such_file.csv"])
 def test_only_a_readable_csv_is_read_ahead(path: Path) -> None:
     """Anything else is left to load_ais, which reads it or reports what is wrong."""
     with start_reading([path], None) as started:

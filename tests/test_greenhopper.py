@@ -29,10 +29,8 @@ from colregs9_cli.manoeuvrability import Restriction, ellipse_polygons
 from colregs9_cli.replay import ReplayResult, run_replay
 from colregs9_cli.units import knots_to_mps
 
-ROOT = Path(__file__).resolve().parents[1]
-SCENARIOS = ROOT / "fixtures" / "scenarios"
-CHART = ROOT / "fixtures" / "charts" / "aalborg_modelled.geojson"
-QUERY = ROOT / "queries" / "greenhopper.toml"
+from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, ROOT, SCENARIOS
+
 GOLDEN = ROOT / "tests" / "golden"
 RESTRICTED, NOT_RESTRICTED = "greenhopper_restricted", "greenhopper_not_restricted"
 NAMES = (RESTRICTED, NOT_RESTRICTED)
@@ -94,9 +92,9 @@ def demo(tmp_path_factory: pytest.TempPathFactory) -> DemoRun:
             "--scenarios",
             str(SCENARIOS),
             "--chart",
-            str(CHART),
+            str(MODELLED_CHART),
             "--query",
-            str(QUERY),
+            str(GREENHOPPER_QUERY),
             "--quiet",
         ],
     )
@@ -158,7 +156,7 @@ def test_demo_leaves_the_figure_and_the_reports(demo: DemoRun, name: str) -> Non
 
 @pytest.mark.parametrize("missing", ["--scenarios", "--chart", "--query"])
 def test_missing_inputs_give_one_error_line(tmp_path: Path, missing: str) -> None:
-    options = {"--scenarios": SCENARIOS, "--chart": CHART, "--query": QUERY}
+    options = {"--scenarios": SCENARIOS, "--chart": MODELLED_CHART, "--query": GREENHOPPER_QUERY}
     options[missing] = tmp_path / "nowhere"
     args = ["demo", "--out", str(tmp_path / "out"), "--quiet"]
     for option, path in options.items():
@@ -185,14 +183,16 @@ def test_a_scenario_without_a_triggered_encounter_is_an_error(tmp_path: Path) ->
     # CPA is 50–60 m in both scenarios: a 10 m CPA_req never triggers
     query = tmp_path / "strict.toml"
     query.write_text(
-        QUERY.read_text(encoding="utf-8").replace("cpa_req_m = 150.0", "cpa_req_m = 10.0"),
+        GREENHOPPER_QUERY.read_text(encoding="utf-8").replace(
+            "cpa_req_m = 150.0", "cpa_req_m = 10.0"
+        ),
         encoding="utf-8",
     )
     result = CliRunner().invoke(
         app,
         [
             *("demo", "--out", str(tmp_path / "out"), "--query", str(query), "--quiet"),
-            *("--scenarios", str(SCENARIOS), "--chart", str(CHART)),
+            *("--scenarios", str(SCENARIOS), "--chart", str(MODELLED_CHART)),
         ],
     )
     lines = [line for line in result.output.splitlines() if line.strip()]
@@ -319,8 +319,8 @@ def test_the_simulated_ais_has_the_papers_speeds(demo: DemoRun, name: str) -> No
 def _replay(ais: Path, out_dir: Path, alpha: float | None = None) -> ReplayResult:
     return run_replay(
         [ais],
-        chart_paths=[CHART],
-        query_path=QUERY,
+        chart_paths=[MODELLED_CHART],
+        query_path=GREENHOPPER_QUERY,
         own_mmsi=[GREENHOPPER_MMSI],
         out_dir=out_dir,
         plots=False,
@@ -376,9 +376,9 @@ def test_alpha_one_still_restricted_and_no_longer_clear(demo: DemoRun, tmp_path:
 def _scenario_with_target_draught(name: str, draught_m: float, tmp_path: Path) -> Path:
     text = (SCENARIOS / f"{name}.toml").read_text(encoding="utf-8")
     edited = text.replace("draught_m = 5.0", f"draught_m = {draught_m}").replace(
-        'chart = "../charts/aalborg_modelled.geojson"', f'chart = "{CHART.as_posix()}"'
+        'chart = "../charts/aalborg_modelled.geojson"', f'chart = "{MODELLED_CHART.as_posix()}"'
     )
-    assert edited.count(f"draught_m = {draught_m}") == 1 and CHART.as_posix() in edited
+    assert edited.count(f"draught_m = {draught_m}") == 1 and MODELLED_CHART.as_posix() in edited
     path = tmp_path / f"{name}.toml"
     path.write_text(edited, encoding="utf-8")
     return path
@@ -395,7 +395,10 @@ def test_mean_draught_target_on_the_modelled_chart(demo: DemoRun, tmp_path: Path
     shore: out of 6 m water, inside 4 m water. The clear target stays clear.
     """
     restricted = run_scenario(
-        _scenario_with_target_draught(RESTRICTED, 3.2, tmp_path), tmp_path, CHART, QUERY
+        _scenario_with_target_draught(RESTRICTED, 3.2, tmp_path),
+        tmp_path,
+        MODELLED_CHART,
+        GREENHOPPER_QUERY,
     )
     summary = restricted.outcome.summary
     assert summary.target_draught_m == 3.2 and not summary.target_dimensions_defaulted
@@ -411,7 +414,7 @@ def test_mean_draught_target_on_the_modelled_chart(demo: DemoRun, tmp_path: Path
 
     # why: every ellipse that is red at 5.0 m lies in 3.2 m water, and what it lacks at
     # 5.0 m is the 4–6 m band, 35–100 m off the shore
-    chart = load_chart([CHART], restricted.replay.frame)
+    chart = load_chart([MODELLED_CHART], restricted.replay.frame)
     water_3_2, water_5 = chart.navigable_water(3.2), chart.navigable_water(5.0)
     red = np.flatnonzero(assessment_5_m.restricted)
     ellipses = ellipse_polygons(
@@ -431,7 +434,10 @@ def test_mean_draught_target_on_the_modelled_chart(demo: DemoRun, tmp_path: Path
         assert lacking.difference(band_4_6_m).area < 1e-6
 
     clear = run_scenario(
-        _scenario_with_target_draught(NOT_RESTRICTED, 3.2, tmp_path), tmp_path, CHART, QUERY
+        _scenario_with_target_draught(NOT_RESTRICTED, 3.2, tmp_path),
+        tmp_path,
+        MODELLED_CHART,
+        GREENHOPPER_QUERY,
     )
     assert clear.outcome.summary.target_estimated_restricted is Restriction.NOT_RESTRICTED
     assert clear.outcome.summary.automaton_path == "D1>D2>D3>D1"

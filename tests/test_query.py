@@ -12,7 +12,8 @@ import pytest
 from colregs9_cli.errors import InputFileError, QueryError
 from colregs9_cli.query import Region, everything_query, load_query
 
-ROOT = Path(__file__).resolve().parents[1]
+from fixture_files import ROOT
+
 SQUARE = {
     "type": "Polygon",
     "coordinates": [[[9.9, 57.0], [10.0, 57.0], [10.0, 57.1], [9.9, 57.0]]],

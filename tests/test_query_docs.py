@@ -5,13 +5,12 @@ from __future__ import annotations
 import dataclasses
 import re
 import tomllib
-from pathlib import Path
 
 from colregs9_cli.colregs import ColregsParams, colregs_params_from_table
 from colregs9_cli.manoeuvrability import ManoeuvrabilityParams
 from colregs9_cli.replay_params import ReplayParams, replay_params_from_table
 
-ROOT = Path(__file__).resolve().parents[1]
+from fixture_files import ROOT
 
 
 def _documented_tables() -> dict[str, dict[str, object]]:

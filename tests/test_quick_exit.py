@@ -14,8 +14,7 @@ import pytest
 
 from colregs9_cli import quick_exit
 
-ROOT = Path(__file__).resolve().parents[1]
-DMA26 = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
+from fixture_files import DMA26, ROOT
 
 
 @pytest.fixture(autouse=True)

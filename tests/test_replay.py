@@ -35,8 +35,8 @@ from colregs9_cli.replay import (
 from colregs9_cli.replay_params import ReplayParams, TargetDimensions
 from colregs9_cli.simulate import simulate_scenario
 
-ROOT = Path(__file__).resolve().parents[1]
-NMEA = ROOT / "fixtures" / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
+from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, NMEA, SCENARIOS
+
 KNOT_MPS = 1852.0 / 3600.0
 GEOD = Geod(ellps="WGS84")
 
@@ -274,9 +274,6 @@ def test_missing_dimensions_take_the_documented_defaults() -> None:
     assert _target_dimensions(vessels, 2, longer) == (80.0, 8.0, 4.5, True)
 
 
-SCENARIOS = ROOT / "fixtures" / "scenarios"
-MODELLED_CHART = ROOT / "fixtures" / "charts" / "aalborg_modelled.geojson"
-GREENHOPPER_QUERY = ROOT / "queries" / "greenhopper.toml"
 GREENHOPPER, TARGET = 219999001, 219999002
 
 

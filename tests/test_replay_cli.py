@@ -11,8 +11,8 @@ from typer.testing import CliRunner
 from colregs9_cli.cli import app
 from colregs9_cli.replay import ENCOUNTER_COLUMNS
 
-ROOT = Path(__file__).resolve().parents[1]
-NMEA = ROOT / "fixtures" / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
+from fixture_files import NMEA, ROOT
+
 ANNAPOLIS_ENC = ROOT / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
 
 DMA_HEADER = (

@@ -5,7 +5,6 @@ from __future__ import annotations
 import hashlib
 import json
 import re
-from pathlib import Path
 
 import matplotlib.image
 import numpy as np
@@ -23,12 +22,10 @@ from colregs9_cli.report.replay_report import (
 from colregs9_cli.simulate import simulate_scenario
 from colregs9_cli.units import MPS_PER_KNOT
 
-ROOT = Path(__file__).resolve().parents[1]
-NMEA = ROOT / "fixtures" / "ais" / "dma_nmea_2013-11-12_5min.txt.gz"
+from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, NMEA, ROOT
+
 OWN = 211356520  # one triggered crossing in the national sample (see test_replay.py)
 SCENARIO = ROOT / "fixtures" / "scenarios" / "greenhopper_restricted.toml"
-MODELLED_CHART = ROOT / "fixtures" / "charts" / "aalborg_modelled.geojson"
-GREENHOPPER_QUERY = ROOT / "queries" / "greenhopper.toml"
 GREENHOPPER = 219999001
 
 # The columns issue 4 asks for, in encounters.csv and in each time series.

@@ -20,9 +20,8 @@ from colregs9_cli.scenario import VesselRole, check_scenario_chart, load_scenari
 from colregs9_cli.simulate import simulate
 from colregs9_cli.units import knots_to_mps
 
-ROOT = Path(__file__).resolve().parents[1]
-SCENARIOS = ROOT / "fixtures" / "scenarios"
-CHART = ROOT / "fixtures" / "charts" / "aalborg_modelled.geojson"
+from fixture_files import MODELLED_CHART, SCENARIOS
+
 NAMES = ("greenhopper_restricted", "greenhopper_not_restricted")
 
 
@@ -31,7 +30,7 @@ FRAME = LocalFrame.centred_on(57.044196, 57.062865, 9.909933, 9.971545)  # regio
 
 @pytest.fixture(scope="module")
 def depth_chart():
-    return load_chart([CHART], FRAME)
+    return load_chart([MODELLED_CHART], FRAME)
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -39,7 +38,7 @@ def test_scenario_parses_with_the_papers_parameters(name: str) -> None:
     scenario = load_scenario(SCENARIOS / f"{name}.toml")
     assert scenario.name == name
     assert (scenario.duration_s, scenario.step_s) == (420.0, 1.0)  # 7.0 min at 1.0 s
-    assert scenario.chart == CHART.resolve()
+    assert scenario.chart == MODELLED_CHART.resolve()
     own = scenario.own
     assert own is not None and own.name == "GREENHOPPER"
     assert (own.length_m, own.draught_m, set(own.speed_kn)) == (11.0, 0.5, {2.0})
@@ -129,7 +128,7 @@ def _write(tmp_path: Path, text: str) -> Path:
 
 def _restricted_text() -> str:
     text = (SCENARIOS / "greenhopper_restricted.toml").read_text(encoding="utf-8")
-    chart = CHART.resolve().as_posix()
+    chart = MODELLED_CHART.resolve().as_posix()
     return text.replace('chart = "../charts/aalborg_modelled.geojson"', f'chart = "{chart}"')
 
 

@@ -15,8 +15,7 @@ from colregs9_cli.geo import LocalFrame
 from colregs9_cli.simulate import DMA_COLUMNS, simulate_scenario
 from colregs9_cli.units import knots_to_mps
 
-ROOT = Path(__file__).resolve().parents[1]
-DMA_SAMPLE = ROOT / "fixtures" / "ais" / "aisdk_2024-09-09_sample.csv"
+from fixture_files import DMA26
 
 # A hand-built route: 5.144 m/s (10 kn) north for exactly 85 s (437.3 m), then 5 kn due east
 # for 600 m; the second vessel's single leg (300 m at 5 kn, 116.6 s) ends inside the run.
@@ -87,7 +86,7 @@ def simulated(tmp_path: Path) -> tuple[pd.DataFrame, Path]:
 
 def test_header_is_the_dma_26_column_layout(simulated) -> None:
     frame, out = simulated
-    expected = DMA_SAMPLE.read_text(encoding="utf-8").splitlines()[0]
+    expected = DMA26.read_text(encoding="utf-8").splitlines()[0]
     assert out.read_text(encoding="utf-8").splitlines()[0] == expected
     assert tuple(frame.columns) == DMA_COLUMNS and len(DMA_COLUMNS) == 26
 

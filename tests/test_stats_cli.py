@@ -25,12 +25,8 @@ from colregs9_cli.dimensions import GroupBy, Per
 from colregs9_cli.report.stats_report import histogram_figure
 from colregs9_cli.stats import run_stats
 
-ROOT = Path(__file__).resolve().parents[1]
-AIS = ROOT / "fixtures" / "ais"
-DMA_2024 = AIS / "aisdk_2024-09-09_sample.csv"
-DMA_2018 = AIS / "aisdk_2018-06-01_sample_22col.csv"
-MARINECADASTRE = AIS / "marinecadastre_2023-01-11_sample.csv"
-NMEA = AIS / "dma_nmea_2013-11-12_5min.txt.gz"
+from fixture_files import DMA22, DMA26, MARINECADASTRE, NMEA, ROOT
+
 LIMFJORDEN = ROOT / "queries" / "limfjorden.toml"
 LIMFJORD_BOX = (56.5, 57.2, 8.2, 10.4)
 
@@ -195,8 +191,8 @@ def _assert_manifest(out: Path, source: Path, expected: pd.DataFrame, units: int
 @pytest.mark.parametrize(
     ("source", "reader", "rows_read"),
     [
-        (DMA_2024, _dma_reports, 20),
-        (DMA_2018, _dma_reports, 138),
+        (DMA26, _dma_reports, 20),
+        (DMA22, _dma_reports, 138),
         (MARINECADASTRE, _marinecadastre_reports, 1000),
     ],
     ids=["dma26", "dma22", "marinecadastre"],
@@ -239,7 +235,7 @@ def test_dma26_figures_by_hand(tmp_path: Path) -> None:
     # The 20 rows of the 2024 sample: one exact duplicate (HUMBRIA SEAWAYS), one AtoN, and
     # three lat 91 rows leave 15 vessels with one position each; 13 report a length, e.g.
     # ARCTIC PRINCESS 288 m (A 223 + B 65) is the longest, KYST-FRB14 9 m the shortest.
-    result = _stats([str(DMA_2024), "--out", str(tmp_path), "--quiet"])
+    result = _stats([str(DMA26), "--out", str(tmp_path), "--quiet"])
     assert result.exit_code == 0, result.output
     table = pd.read_csv(tmp_path / "dimension_stats.csv").set_index("dimension")
     assert table.loc["length_m", ["count", "min", "max"]].tolist() == [13, 9.0, 288.0]
@@ -351,7 +347,7 @@ BOX = "[region]\nlat_min = 56.5\nlat_max = 57.2\nlon_min = 8.2\nlon_max = 10.4\n
 def test_bad_input_gives_one_error_line(
     tmp_path: Path, case: str, exit_code: int, needle: str
 ) -> None:
-    ais = DMA_2024
+    ais = DMA26
     args: list[str] = []
     if case == "missing file":
         ais = tmp_path / "nope.csv"
@@ -371,7 +367,7 @@ def test_bad_input_gives_one_error_line(
         ais.write_bytes(data[: len(data) // 2])
     elif case == "non-UTF-8 byte":
         ais = tmp_path / "latin1.csv"
-        ais.write_bytes(DMA_2024.read_bytes().replace(b"HANNE", b"H\xc5NNE"))
+        ais.write_bytes(DMA26.read_bytes().replace(b"HANNE", b"H\xc5NNE"))
     elif case == "TOML syntax error":
         args = ["--query", str(_query(tmp_path, 'name = "broken\n' + BOX))]
     elif case == "unknown query key":

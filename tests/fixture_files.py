@@ -1,0 +1,16 @@
+"""Paths of the repository's fixture files that several test modules read."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+FIXTURES = ROOT / "fixtures"
+AIS_FIXTURES = FIXTURES / "ais"
+DMA26 = AIS_FIXTURES / "aisdk_2024-09-09_sample.csv"
+DMA22 = AIS_FIXTURES / "aisdk_2018-06-01_sample_22col.csv"
+MARINECADASTRE = AIS_FIXTURES / "marinecadastre_2023-01-11_sample.csv"
+NMEA = AIS_FIXTURES / "dma_nmea_2013-11-12_5min.txt.gz"
+SCENARIOS = FIXTURES / "scenarios"
+MODELLED_CHART = FIXTURES / "charts" / "aalborg_modelled.geojson"
+GREENHOPPER_QUERY = ROOT / "queries" / "greenhopper.toml"
