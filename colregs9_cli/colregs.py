@@ -1,30 +1,40 @@
-"""COLREGs rules 13–15: the situation and the roles (the paper's automaton G_a, DESIGN §5).
+"""COLREGs rules 13–15: one situation per pair and both vessels' roles (the paper's G_a,
+DESIGN §5).
 
 Angles: β is the relative bearing of the target from own ship and β' that of own ship from
 the target, each measured clockwise from the observer's course, in [0, 360). The course is
 COG or heading (``ColregsParams.course_source``). "Closing" means the range is decreasing:
 ``p·v < 0`` for the target's relative position p and relative velocity v (over ground).
 
-The rules, in order of precedence (all sector bounds inclusive; the parameter ranges keep the
-head-on and overtaking sectors apart, so only "none first" and "crossing last" matter):
+The pair's geometry is classified once, and both roles follow from it, so that swapping the
+seats swaps the roles and nothing else. In order of precedence:
 
 1. **none**: not closing (range opening or steady, or unknown motion). Roles: none.
-2. **overtaking**: one vessel is in the other's astern sector
-   [``overtaking_sector_min_deg``, ``overtaking_sector_max_deg``] (default 112.5°–247.5°,
-   "more than 22.5° abaft her beam") while the other is not in hers. The vessel coming up
-   from astern gives way (rule 13), the other stands on. ``own_overtaking`` says which.
-3. **head-on**: each is within ±``head_on_half_angle_deg`` of the other's bow (β and β' in
-   [360−θ, 360) ∪ [0, θ]). Both give way (rule 14).
-4. **crossing**: everything else (also two vessels each in the other's astern sector). Each
-   vessel gives way when the other is on her starboard side (rule 15): bearing in (0°, 180°).
-   Dead ahead (0°) and dead astern (180°) are not a side; a vessel with the other exactly
-   there gives way unless she herself is on the other's starboard side. So exactly one vessel
-   gives way in an ordinary crossing; two vessels passing starboard to starboard (each on the
-   other's starboard side) both give way, and two passing port to port both stand on.
+2. **overtaking** (rule 13): one vessel is strictly more than 22.5° abaft the other's beam,
+   β or β' strictly inside (``overtaking_sector_min_deg``, ``overtaking_sector_max_deg``),
+   while the other is not in hers. The vessel coming up from astern gives way.
+3. **head-on** (rule 14): each is within ±``head_on_half_angle_deg`` of the other's bow. Both
+   give way. Rule 14(c), in doubt assume head-on: each vessel sees the other on the *same*
+   side (both on the starboard bow or both on the port bow), each within
+   ``head_on_doubt_deg`` of her bow; such courses are within that angle of reciprocal.
+4. **crossing** (rule 15), everything else: exactly one vessel gives way, the one that has the
+   other on her starboard side. When the two see each other on the same side (or on a
+   fore-and-aft line), rule 15's words name both or neither; the vessel whose bearing is
+   farther from her fore-and-aft line keeps her side and decides, because the other's side
+   is the one a small course error would flip. An exact tie (reciprocal courses, equal
+   bearings) is the rule 14(c) doubt again: head-on.
+
+A situation is ``ambiguous`` when moving either bearing by ``ambiguity_margin_deg`` would
+change it or either role: it lies near a sector boundary, where the course noise of AIS can
+decide. ``SituationBasis`` records whether it rests on the sectors alone, on rule 14(c) or on
+the same-side reading of rule 15. The replay fixes the situation at
+the trigger and holds it until the pair is past (rule 13(d)); ``classify`` itself has no
+memory and also gives the instantaneous geometry of every step.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from enum import StrEnum
@@ -48,31 +58,46 @@ class Situation(StrEnum):
     NONE = "none"
 
 
+class SituationBasis(StrEnum):
+    """What settled the situation: the sectors alone, or a reading of a doubtful geometry."""
+
+    SECTORS = "sectors"
+    HEAD_ON_IN_DOUBT = "head-on in doubt"  # rule 14(c)
+    SAME_SIDE = "same-side crossing"  # rule 15 names both or neither; see the module docstring
+    NONE = "none"
+
+
 class Role(StrEnum):
     GIVE_WAY = "give-way"
     STAND_ON = "stand-on"
     NONE = "none"
-
-    def inverted(self) -> Role:
-        """Give-way ↔ stand-on (rule 9's inversion); none stays none."""
-        return _INVERSE_ROLE[self]
 
 
 # Lookup tables that turn integer codes into enum members, vectorised.
 _SITUATIONS = np.array(
     [Situation.OVERTAKING, Situation.HEAD_ON, Situation.CROSSING, Situation.NONE], dtype=object
 )
+_BASES = np.array(
+    [
+        SituationBasis.SECTORS,
+        SituationBasis.HEAD_ON_IN_DOUBT,
+        SituationBasis.SAME_SIDE,
+        SituationBasis.NONE,
+    ],
+    dtype=object,
+)
 _ROLES = np.array([Role.GIVE_WAY, Role.STAND_ON, Role.NONE], dtype=object)
-_INVERSE_ROLE = {Role.GIVE_WAY: Role.STAND_ON, Role.STAND_ON: Role.GIVE_WAY, Role.NONE: Role.NONE}
 
 
 @dataclass(frozen=True)
 class ColregsParams:
-    """The ``[colregs]`` table: sector angles (degrees) and the course source."""
+    """The ``[colregs]`` table: sector angles and margins (degrees) and the course source."""
 
     head_on_half_angle_deg: float = 6.0
+    head_on_doubt_deg: float = 22.5
     overtaking_sector_min_deg: float = 112.5
     overtaking_sector_max_deg: float = 247.5
+    ambiguity_margin_deg: float = 3.0
     course_source: CourseSource = CourseSource.COG
 
     def __post_init__(self) -> None:
@@ -81,12 +106,23 @@ class ColregsParams:
             raise ParameterError(
                 f"[colregs] head_on_half_angle_deg = {theta!r}: give an angle in [0, 90)"
             )
+        doubt = self.head_on_doubt_deg
+        if not (math.isfinite(doubt) and theta <= doubt < 90.0):
+            raise ParameterError(
+                f"[colregs] head_on_doubt_deg = {doubt!r}: give an angle from "
+                f"head_on_half_angle_deg ({theta:g}) up to 90"
+            )
         low, high = self.overtaking_sector_min_deg, self.overtaking_sector_max_deg
         if not (math.isfinite(low) and math.isfinite(high) and 90.0 < low < 180.0 < high < 270.0):
             raise ParameterError(
                 f"[colregs] overtaking sector [{low!r}, {high!r}]: the sector must lie abaft "
                 "the beam and contain dead astern, 90 < overtaking_sector_min_deg < 180 < "
                 "overtaking_sector_max_deg < 270"
+            )
+        margin = self.ambiguity_margin_deg
+        if not (math.isfinite(margin) and 0.0 <= margin < 45.0):
+            raise ParameterError(
+                f"[colregs] ambiguity_margin_deg = {margin!r}: give an angle in [0, 45)"
             )
 
 
@@ -131,12 +167,14 @@ class Kinematics:
 
 @dataclass(frozen=True)
 class ColregsEvaluation:
-    """G_a's output per step (arrays of equal length)."""
+    """G_a's output per step (arrays of equal length), seen from the own-ship seat."""
 
     situation: NDArray[np.object_]  # Situation
     own_role: NDArray[np.object_]  # Role
     target_role: NDArray[np.object_]  # Role
     own_overtaking: NDArray[np.bool_]  # True only in overtaking with own ship astern
+    ambiguous: NDArray[np.bool_]
+    basis: NDArray[np.object_]  # SituationBasis
     beta_deg: NDArray[np.float64]  # target's relative bearing from own ship
     beta_prime_deg: NDArray[np.float64]  # own ship's relative bearing from the target
     closing: NDArray[np.bool_]
@@ -178,53 +216,116 @@ def evaluate_colregs(
     return classify(beta, beta_prime, closing, params)
 
 
+@dataclass(frozen=True)
+class _Sectors:
+    """The situation code (index into ``_SITUATIONS``), who gives way, and the basis code."""
+
+    situation: NDArray[np.int64]
+    own_gives_way: NDArray[np.bool_]
+    target_gives_way: NDArray[np.bool_]
+    basis: NDArray[np.int64]
+
+
+def _sectors(
+    beta: NDArray[np.float64],
+    beta_prime: NDArray[np.float64],
+    closing: NDArray[np.bool_],
+    params: ColregsParams,
+) -> _Sectors:
+    """The rules of the module docstring on bearings in [0, 360) (NaN: no situation)."""
+    known = closing & np.isfinite(beta) & np.isfinite(beta_prime)
+
+    def astern(bearing: NDArray[np.float64]) -> NDArray[np.bool_]:
+        return (bearing > params.overtaking_sector_min_deg) & (
+            bearing < params.overtaking_sector_max_deg
+        )
+
+    def within_of_bow(bearing: NDArray[np.float64], angle_deg: float) -> NDArray[np.bool_]:
+        return (bearing <= angle_deg) | (bearing >= 360.0 - angle_deg)
+
+    def side(bearing: NDArray[np.float64]) -> NDArray[np.int64]:
+        """+1 starboard, −1 port, 0 on the fore-and-aft line."""
+        return np.sign(np.sin(np.radians(bearing))).astype(np.int64) * (
+            (bearing != 0.0) & (bearing != 180.0)
+        )
+
+    def off_fore_aft_line(bearing: NDArray[np.float64]) -> NDArray[np.float64]:
+        folded = np.mod(bearing, 180.0)
+        return np.minimum(folded, 180.0 - folded)
+
+    own_overtakes = known & astern(beta_prime) & ~astern(beta)
+    target_overtakes = known & astern(beta) & ~astern(beta_prime)
+    overtaking = own_overtakes | target_overtakes
+    open_water = known & ~overtaking
+
+    own_side, target_side = side(beta), side(beta_prime)
+    opposite = own_side * target_side < 0
+    own_distance, target_distance = off_fore_aft_line(beta), off_fore_aft_line(beta_prime)
+    head_on_sectors = within_of_bow(beta, params.head_on_half_angle_deg) & within_of_bow(
+        beta_prime, params.head_on_half_angle_deg
+    )
+    in_doubt = (
+        (own_side == target_side)
+        & within_of_bow(beta, params.head_on_doubt_deg)
+        & within_of_bow(beta_prime, params.head_on_doubt_deg)
+    )
+    tie = ~opposite & (own_distance == target_distance)
+    head_on = open_water & (head_on_sectors | in_doubt | tie)
+    crossing = open_water & ~head_on
+
+    # The deciding vessel keeps her side; with opposite sides either one decides alike.
+    own_decides = opposite | (own_distance > target_distance)
+    deciding_side = np.where(own_decides, own_side, target_side)
+    own_gives_way_crossing = np.where(own_decides, deciding_side > 0, deciding_side < 0)
+
+    situation = np.select([overtaking, head_on, crossing], [0, 1, 2], default=3)
+    own_gives_way = own_overtakes | head_on | (crossing & own_gives_way_crossing)
+    target_gives_way = target_overtakes | head_on | (crossing & ~own_gives_way_crossing)
+    doubtful_head_on = head_on & ~head_on_sectors
+    basis = np.select(
+        [~known, doubtful_head_on, crossing & ~opposite], [3, 1, 2], default=0
+    ).astype(np.int64)
+    return _Sectors(situation, own_gives_way, target_gives_way, basis)
+
+
 def classify(
     beta_deg: ArrayLike, beta_prime_deg: ArrayLike, closing: ArrayLike, params: ColregsParams
 ) -> ColregsEvaluation:
-    """The rules of the module docstring on given bearings and closing flags."""
+    """The pair model of the module docstring on given bearings and closing flags."""
     beta = np.atleast_1d(np.asarray(beta_deg, dtype=float))
     beta_prime = np.atleast_1d(np.asarray(beta_prime_deg, dtype=float))
     closing_now = np.atleast_1d(np.asarray(closing, dtype=bool))
     beta, beta_prime, closing_now = np.broadcast_arrays(beta, beta_prime, closing_now)
+    beta, beta_prime = wrap_deg(beta), wrap_deg(beta_prime)
+    result = _sectors(beta, beta_prime, closing_now, params)
 
-    def astern(bearing: NDArray[np.float64]) -> NDArray[np.bool_]:
-        return (bearing >= params.overtaking_sector_min_deg) & (
-            bearing <= params.overtaking_sector_max_deg
-        )
-
-    def near_bow(bearing: NDArray[np.float64]) -> NDArray[np.bool_]:
-        theta = params.head_on_half_angle_deg
-        return (bearing <= theta) | (bearing >= 360.0 - theta)
-
-    def gives_way_crossing(
-        bearing: NDArray[np.float64], other_bearing: NDArray[np.float64]
-    ) -> NDArray[np.bool_]:
-        def on_starboard(b: NDArray[np.float64]) -> NDArray[np.bool_]:
-            return (b > 0.0) & (b < 180.0)
-
-        on_fore_aft_line = (bearing == 0.0) | (bearing == 180.0)
-        return on_starboard(bearing) | (on_fore_aft_line & ~on_starboard(other_bearing))
-
-    own_overtakes = closing_now & astern(beta_prime) & ~astern(beta)
-    target_overtakes = closing_now & astern(beta) & ~astern(beta_prime)
-    overtaking = own_overtakes | target_overtakes
-    head_on = closing_now & ~overtaking & near_bow(beta) & near_bow(beta_prime)
-    crossing = closing_now & ~overtaking & ~head_on
-
-    situation_code = np.select([overtaking, head_on, crossing], [0, 1, 2], default=3)
-    own_gives_way = own_overtakes | head_on | (crossing & gives_way_crossing(beta, beta_prime))
-    target_gives_way = (
-        target_overtakes | head_on | (crossing & gives_way_crossing(beta_prime, beta))
-    )
+    ambiguous = np.zeros(result.situation.shape, dtype=bool)
+    margin = params.ambiguity_margin_deg
+    if margin > 0.0:
+        for shift, shift_prime in itertools.product((-margin, 0.0, margin), repeat=2):
+            if shift == shift_prime == 0.0:
+                continue
+            moved = _sectors(
+                wrap_deg(beta + shift), wrap_deg(beta_prime + shift_prime), closing_now, params
+            )
+            ambiguous |= (
+                (moved.situation != result.situation)
+                | (moved.own_gives_way != result.own_gives_way)
+                | (moved.target_gives_way != result.target_gives_way)
+            )
+    ambiguous &= result.situation != 3
 
     def role(gives_way: NDArray[np.bool_]) -> NDArray[np.object_]:
-        return _ROLES[np.where(closing_now, np.where(gives_way, 0, 1), 2)]
+        return _ROLES[np.where(result.situation == 3, 2, np.where(gives_way, 0, 1))]
 
+    own_overtaking = (result.situation == 0) & result.own_gives_way
     return ColregsEvaluation(
-        situation=_SITUATIONS[situation_code],
-        own_role=role(own_gives_way),
-        target_role=role(target_gives_way),
-        own_overtaking=own_overtakes,
+        situation=_SITUATIONS[result.situation],
+        own_role=role(result.own_gives_way),
+        target_role=role(result.target_gives_way),
+        own_overtaking=own_overtaking,
+        ambiguous=ambiguous,
+        basis=_BASES[result.basis],
         beta_deg=beta,
         beta_prime_deg=beta_prime,
         closing=closing_now,

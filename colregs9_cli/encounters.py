@@ -367,17 +367,22 @@ SERIES_VESSEL_COLUMNS: tuple[str, ...] = STATE_COLUMNS
 
 
 def encounter_series(
-    tracks: Tracks, encounter: Encounter, from_step: int | None = None
+    tracks: Tracks,
+    encounter: Encounter,
+    from_step: int | None = None,
+    to_step: int | None = None,
 ) -> pd.DataFrame:
-    """The encounter's steps (from ``from_step``, default its start, to its end).
+    """The encounter's steps at which both vessels have samples, from ``from_step`` (default
+    its start) to ``to_step`` (default its end; a later step follows the tracks past it).
 
     Columns: ``step``, ``timestamp``, ``own_<c>`` and ``target_<c>`` for each ``c`` in
     ``SERIES_VESSEL_COLUMNS``, then ``rel_north_m``, ``rel_east_m`` (target minus own),
     ``range_m``, ``cpa_m``, ``tcpa_s``.
     """
     first = encounter.start_step if from_step is None else from_step
+    last = encounter.end_step if to_step is None else to_step
     samples = tracks.samples
-    in_window = samples["step"].between(first, encounter.end_step)
+    in_window = samples["step"].between(first, last)
     columns = ["step", *SERIES_VESSEL_COLUMNS]
 
     def side(mmsi: int, prefix: str) -> pd.DataFrame:

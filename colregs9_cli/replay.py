@@ -1,29 +1,30 @@
-"""``colregs9 replay``: historical AIS, encounter by encounter, through G_a and G_d (DESIGN §5).
+"""``colregs9 replay``: historical AIS, pair by pair, through G_a and G_d (DESIGN §5).
 
 The pipeline: read the AIS through the query → the run's local frame (the query's region, or
 the extent of the data when the query has none) → per-vessel tracks (``tracks.py``; reports
 dropped as same-second duplicates or speed jumps go into the rejects ledger) → encounters
-(``encounters.py``) → for each triggered encounter, from the trigger until the pair passes
-(TCPA < 0) or the encounter ends, the COLREGs evaluation G_a (``colregs.py``) and the rule 9
-automaton G_d (``rule9.py``) at every step. The encounter's verdict is the one at the
-trigger step; the later steps are its time series.
+(``encounters.py``) → for each triggered pair, evaluated once for both seats:
 
-Manoeuvrability (event d3) is estimated for the target with her length, breadth and draught.
-A missing dimension takes the ``[replay]`` default, the mean of the paper's Table 1, and the
-encounter is flagged ``target_dimensions_defaulted``. No chart, or a target outside
-the chart's coverage, gives ``unknown``: ¬d3 for the automaton, recorded as ``unknown``.
+- **G_a** (``colregs.py``) classifies the pair at the trigger. That situation and both roles
+  are held until the pair is past (rule 13(d)); the time series also records the
+  instantaneous geometry of every step (``situation_now``).
+- **G_d** (``rule9.py``) runs in both seats at every step, and ``decide_pair`` combines them
+  with rules 13 and 18 into the pair's final roles. The verdict is the one at the trigger.
+- **Manoeuvrability** (event d3) is estimated for both vessels at the trigger (it is the
+  verdict and the figure), and later only for a vessel whose G_d reaches D3 there (she gives
+  way and does not report a restricted status), at most every ``reassess_every_s``;
+  otherwise the last estimate is carried forward. No chart, or a vessel outside the chart's
+  coverage, gives ``unknown``: ¬d3 for the automaton, recorded as ``unknown``.
+- **Dimensions** a vessel does not report take the defaults of ``vessel_defaults.py`` (by
+  Class A/B and ship type); a verdict in which the estimator's answer for such a vessel
+  entered G_d is flagged ``verdict_rests_on_defaults``.
+- **Audit facts** (``audit.py``) over the pair's data from the trigger: the series follows
+  both tracks past the end of the candidate run, to the pass or for at most TCPA +
+  ``tcpa_act_s`` after the trigger, and stops at the first step where either track stops.
 
-The estimate is made at the trigger step (always: it is the verdict and the figure), and at a
-later step only when G_d reaches D3 there (own ship stand-on, the target not reporting a
-restricted status) and the last estimate is at least ``reassess_every_s`` old; otherwise the
-last estimate is carried forward. Every step of the time series says which step its estimate
-was computed at (``restricted_assessed_utc``).
-
-Audit columns beyond the paper: ``actual_min_separation_m`` is the least range between the
-two resampled tracks over the whole encounter; ``give_way_vessel_acted`` says whether every
-vessel that should give way after rule 9 changed course by at least ``course_change_deg`` or
-speed by at least ``speed_change_frac`` (of her speed at the trigger) at some step between
-the trigger and the actual closest approach after it. It is empty when no vessel gives way.
+Each pair gives one ``PairOutcome`` (pairs.csv) and one ``EncounterOutcome`` per reported
+seat (encounters.csv and the per-encounter files); both seats of a pair carry the same
+situation, final roles and audit facts.
 """
 
 from __future__ import annotations
@@ -41,12 +42,25 @@ import pandas as pd
 
 from .ais.ledger import RejectReason, RejectsLedger
 from .ais.load import AisData, load_ais
+from .audit import (
+    INSUFFICIENT_CONDUCT,
+    Action,
+    Conduct,
+    ConductParams,
+    Fact,
+    all_of,
+    conduct,
+    negated,
+    passage,
+)
 from .chart import Chart, project_charts, read_charts
 from .colregs import (
+    ColregsEvaluation,
     ColregsParams,
     Kinematics,
     Role,
     Situation,
+    SituationBasis,
     colregs_params_from_table,
     evaluate_colregs,
 )
@@ -61,12 +75,12 @@ from .manoeuvrability import (
 )
 from .progress import progress_bar, progress_enabled
 from .query import Query, everything_query, load_query
-from .replay_params import ReplayParams, TargetDimensions, replay_params_from_table
+from .replay_params import ReplayParams, replay_params_from_table
 from .report.manifest import inputs_manifest, jsonable, query_manifest, run_header
 from .report.replay_report import format_summary, write_replay_reports
-from .rule9 import Rule9Assessment, assess_rule9
+from .rule9 import DecidingRule, Finding, PairVerdict, decide_pair, nav_status_finding
 from .tracks import Tracks, build_tracks
-from .units import signed_angle_deg
+from .vessel_defaults import VesselDimensions, vessel_dimensions
 
 
 @dataclass(frozen=True)
@@ -80,10 +94,88 @@ class ReplayRunParams:
 
 
 @dataclass(frozen=True)
+class VesselAtTrigger:
+    """One vessel of a pair: who she is, her state at the trigger and her conduct after it."""
+
+    mmsi: int
+    name: str | None
+    dimensions: VesselDimensions
+    nav_status: int | None
+    course_deg: float
+    speed_kn: float
+    estimated_restricted: Restriction
+    conduct: Conduct
+    action_before_cpa_s: float | None
+
+
+@dataclass(frozen=True)
+class PairSummary:
+    """One row of pairs.csv: the pair-level verdict; vessel a has the lower MMSI."""
+
+    pair_id: str
+    mmsi_a: int
+    mmsi_b: int
+    name_a: str | None
+    name_b: str | None
+    seats_reported: str
+    start_utc: pd.Timestamp
+    trigger_utc: pd.Timestamp
+    end_utc: pd.Timestamp
+    situation: Situation
+    situation_ambiguous: bool
+    situation_basis: SituationBasis
+    role_colregs_a: Role
+    role_colregs_b: Role
+    nav_status_a: int | None
+    nav_status_b: int | None
+    estimated_restricted_a: Restriction
+    estimated_restricted_b: Restriction
+    automaton_path_a: str
+    automaton_path_b: str
+    rule9_applied: bool
+    deciding_rule: DecidingRule
+    both_restricted: bool
+    role_final_a: Role
+    role_final_b: Role
+    give_way_vessels: str
+    verdict_rests_on_defaults: bool
+    range_m_at_trigger: float
+    cpa_m: float
+    tcpa_s: float
+    data_covers_cpa: bool
+    actual_min_separation_m: float | None
+    actual_min_separation_utc: pd.Timestamp | None
+    give_way_vessel_acted: Fact | None
+    give_way_action: str
+    action_before_cpa_s: str
+    stand_on_vessel_kept_course: Fact | None
+    action_a: Action
+    action_b: Action
+    length_m_a: float
+    breadth_m_a: float
+    draught_m_a: float
+    defaulted_dimensions_a: str
+    length_m_b: float
+    breadth_m_b: float
+    draught_m_b: float
+    defaulted_dimensions_b: str
+
+
+PAIR_COLUMNS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(PairSummary))
+
+
+@dataclass(frozen=True)
 class EncounterSummary:
-    """One row of encounters.csv; the field order is the column order."""
+    """One row of encounters.csv (one seat of a pair); the field order is the column order.
+
+    ``automaton_path`` is this seat's G_d (own ship asks about the target) and
+    ``target_seat_automaton_path`` the other seat's (the target asks about own ship).
+    Everything about the pair (situation, final roles, audit facts) is the same in both
+    seats' rows, seen from the other side.
+    """
 
     encounter_id: str
+    pair_id: str
     own_mmsi: int
     target_mmsi: int
     own_name: str | None
@@ -92,79 +184,101 @@ class EncounterSummary:
     trigger_utc: pd.Timestamp
     end_utc: pd.Timestamp
     situation: Situation
+    situation_ambiguous: bool
+    situation_basis: SituationBasis
     own_role_colregs: Role
     target_role_colregs: Role
+    own_nav_status: int | None
     target_nav_status: int | None
     target_reports_restricted: bool
     target_estimated_restricted: Restriction
-    rule9_applied: bool
-    own_role_final: Role
+    own_estimated_restricted: Restriction
     automaton_path: str
+    target_seat_automaton_path: str
+    rule9_applied: bool
+    deciding_rule: DecidingRule
+    both_restricted: bool
+    own_role_final: Role
+    target_role_final: Role
+    give_way_vessel: str
+    give_way_vessels: str
+    verdict_rests_on_defaults: bool
     range_m_at_trigger: float
     cpa_m: float
     tcpa_s: float
-    actual_min_separation_m: float
-    actual_min_separation_utc: pd.Timestamp
-    give_way_vessel: str
-    give_way_vessel_acted: bool | None
+    data_covers_cpa: bool
+    actual_min_separation_m: float | None
+    actual_min_separation_utc: pd.Timestamp | None
+    give_way_vessel_acted: Fact | None
+    give_way_action: str
+    action_before_cpa_s: str
+    stand_on_vessel_kept_course: Fact | None
     own_course_deg_at_trigger: float
     own_speed_kn_at_trigger: float
     target_course_deg_at_trigger: float
     target_speed_kn_at_trigger: float
+    own_length_m: float
+    own_breadth_m: float
+    own_draught_m: float
+    own_dimensions_defaulted: str
     target_length_m: float
     target_breadth_m: float
     target_draught_m: float
-    target_dimensions_defaulted: bool
+    target_dimensions_defaulted: str
 
 
 ENCOUNTER_COLUMNS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(EncounterSummary))
 
+# Per-vessel columns of a time series; each seat's series has them as own_* and target_*.
+SERIES_VESSEL_FIELDS: tuple[str, ...] = (
+    "lat_deg",
+    "lon_deg",
+    "north_m",
+    "east_m",
+    "cog_deg",
+    "heading_deg",
+    "course_deg",
+    "sog_kn",
+    "nav_status",
+)
 SERIES_COLUMNS: tuple[str, ...] = (
     "step",
     "timestamp",
-    "own_lat_deg",
-    "own_lon_deg",
-    "own_north_m",
-    "own_east_m",
-    "own_cog_deg",
-    "own_heading_deg",
-    "own_course_deg",
-    "own_sog_kn",
-    "own_nav_status",
-    "target_lat_deg",
-    "target_lon_deg",
-    "target_north_m",
-    "target_east_m",
-    "target_cog_deg",
-    "target_heading_deg",
-    "target_course_deg",
-    "target_sog_kn",
-    "target_nav_status",
+    *(f"own_{name}" for name in SERIES_VESSEL_FIELDS),
+    *(f"target_{name}" for name in SERIES_VESSEL_FIELDS),
     "range_m",
     "cpa_m",
     "tcpa_s",
     "beta_deg",
     "beta_prime_deg",
+    "situation_now",
+    "situation_now_ambiguous",
     "situation",
     "own_role_colregs",
     "target_role_colregs",
+    "own_reports_restricted",
     "target_reports_restricted",
+    "own_estimated_restricted",
     "target_estimated_restricted",
-    "restricted_assessed_utc",
+    "own_assessed_utc",
+    "target_assessed_utc",
     "automaton_state",
     "automaton_path",
+    "target_seat_automaton_path",
     "rule9_applied",
+    "deciding_rule",
     "own_role_final",
+    "target_role_final",
 )
 
 
 @dataclass(frozen=True)
 class EncounterOutcome:
-    """A triggered encounter: its verdict, time series and what its figure shows.
+    """One seat of a triggered pair: its row, time series and what its figure shows.
 
-    ``own_track``/``target_track`` (``north_m``, ``east_m``) cover the whole encounter;
-    ``*_at_tcpa_m`` are (north, east) predicted at constant velocity from the trigger to TCPA;
-    ``assessment`` is the manoeuvrability estimate at the trigger.
+    ``own_track``/``target_track`` (``north_m``, ``east_m``) cover the encounter and the
+    audit window after it; ``*_at_tcpa_m`` are (north, east) predicted at constant velocity
+    from the trigger to TCPA; ``assessment`` is the target's manoeuvrability at the trigger.
     """
 
     summary: EncounterSummary
@@ -177,6 +291,14 @@ class EncounterOutcome:
 
 
 @dataclass(frozen=True)
+class PairOutcome:
+    """A triggered pair: its pair-level row and one outcome per reported seat."""
+
+    summary: PairSummary
+    seats: tuple[EncounterOutcome, ...]
+
+
+@dataclass(frozen=True)
 class ReplayCounts:
     vessels: int
     segments: int
@@ -184,6 +306,7 @@ class ReplayCounts:
     candidate_pairs: int
     encounters: int
     triggered: int
+    triggered_pairs: int
 
 
 @dataclass(frozen=True)
@@ -194,10 +317,21 @@ class ReplayResult:
     out_dir: Path
     frame: LocalFrame
     params: ReplayRunParams
-    encounters: tuple[EncounterOutcome, ...]
+    pairs: tuple[PairOutcome, ...]
     counts: ReplayCounts
     manifest: dict[str, Any]
     files: tuple[Path, ...]
+
+    @property
+    def encounters(self) -> tuple[EncounterOutcome, ...]:
+        """Every reported seat, ordered by start, own MMSI and target MMSI."""
+        seats = [seat for pair in self.pairs for seat in pair.seats]
+        return tuple(
+            sorted(
+                seats,
+                key=lambda o: (o.summary.start_utc, o.summary.own_mmsi, o.summary.target_mmsi),
+            )
+        )
 
     @property
     def text(self) -> str:
@@ -267,65 +401,45 @@ def _text_or_none(value: Any) -> str | None:
     return None if value is None or (isinstance(value, float) and math.isnan(value)) else str(value)
 
 
-def _target_dimensions(
-    vessels: pd.DataFrame, mmsi: int, defaults: TargetDimensions
-) -> tuple[float, float, float, bool]:
-    """(length, breadth, draught, defaulted) of a vessel, defaults for what she does not report."""
-    values = []
-    defaulted = False
-    for name in ("length_m", "breadth_m", "draught_m"):
-        value = vessels.at[mmsi, name] if name in vessels.columns else None
-        if value is None or pd.isna(value) or float(value) <= 0.0:
-            values.append(float(getattr(defaults, name)))
-            defaulted = True
-        else:
-            values.append(float(value))
-    return values[0], values[1], values[2], defaulted
+def _static(vessels: pd.DataFrame, mmsi: int) -> dict[str, Any]:
+    """A vessel's static AIS fields (empty when she sent none)."""
+    if mmsi not in vessels.index:
+        return {}
+    return {name: value for name, value in vessels.loc[mmsi].items() if not _missing(value)}
+
+
+def _missing(value: Any) -> bool:
+    return value is None or (not isinstance(value, str) and bool(pd.isna(value)))
 
 
 def _nav_status(value: Any) -> int | None:
     return None if pd.isna(value) else int(value)
 
 
-def _acted(course_deg: np.ndarray, speed_kn: np.ndarray, params: ReplayParams) -> bool:
-    """Course changed by ≥ course_change_deg or speed by ≥ speed_change_frac vs the first step."""
-    course_change = np.abs(signed_angle_deg(course_deg - course_deg[0]))
-    if np.nanmax(course_change, initial=0.0) >= params.course_change_deg:
-        return True
-    if speed_kn[0] <= 0.0:
-        return bool(np.nanmax(speed_kn, initial=0.0) > 0.0)
-    speed_change = np.abs(speed_kn - speed_kn[0]) / speed_kn[0]
-    return bool(np.nanmax(speed_change, initial=0.0) >= params.speed_change_frac)
-
-
 @dataclass
 class _Estimator:
-    """The target's manoeuvrability estimate, made when needed and carried forward."""
+    """A vessel's manoeuvrability estimate, made when needed and carried forward."""
 
     chart: Chart | None
     params: ManoeuvrabilityParams
-    length_m: float
-    breadth_m: float
-    draught_m: float
+    dimensions: VesselDimensions
     reassess_steps: int
     assessed_row: int = -1
     assessment: ManoeuvrabilityAssessment | None = None
 
-    def at(
-        self, target: dict[str, np.ndarray], row: int, needed: bool
-    ) -> ManoeuvrabilityAssessment:
-        """The estimate for ``row`` of the target's state arrays (made anew when due)."""
+    def at(self, state: dict[str, np.ndarray], row: int, needed: bool) -> ManoeuvrabilityAssessment:
+        """The estimate for ``row`` of the vessel's state arrays (made anew when due)."""
         stale = self.assessment is None or row - self.assessed_row >= self.reassess_steps
         if self.assessment is None or (needed and stale):
             self.assessment = assess_manoeuvrability(
                 self.chart,
-                float(target["north_m"][row]),
-                float(target["east_m"][row]),
-                float(target["course_deg"][row]),
-                float(target["speed_mps"][row]),
-                self.length_m,
-                self.breadth_m,
-                self.draught_m,
+                float(state["north_m"][row]),
+                float(state["east_m"][row]),
+                float(state["course_deg"][row]),
+                float(state["speed_mps"][row]),
+                self.dimensions.length_m,
+                self.dimensions.breadth_m,
+                self.dimensions.draught_m,
                 self.params,
             )
             self.assessed_row = row
@@ -347,50 +461,17 @@ def pair_tracks(tracks: Tracks, mmsis: tuple[int, int]) -> Tracks:
     return dataclasses.replace(tracks, samples=pd.concat(parts))
 
 
-def evaluate_encounter(
-    tracks: Tracks,
-    encounter: Encounter,
-    chart: Chart | None,
-    params: ReplayRunParams,
-) -> EncounterOutcome:
-    """G_a and G_d at every step from the trigger until the pair passes or the encounter ends."""
-    if encounter.trigger_step is None:
-        raise ValueError(f"encounter {encounter.encounter_id} never triggered")
-    full = encounter_series(
-        pair_tracks(tracks, (encounter.own_mmsi, encounter.target_mmsi)), encounter
-    )
-    from_trigger = full[full["step"] >= encounter.trigger_step].reset_index(drop=True)
-    passed = np.flatnonzero(from_trigger["tcpa_s"].to_numpy() < 0.0)
-    series = from_trigger.iloc[: passed[0] if len(passed) else len(from_trigger)].copy()
-    series = series.reset_index(drop=True)
+def _contiguous_rows(steps: np.ndarray) -> int:
+    """How many rows from the first run on consecutive steps (both tracks present)."""
+    gaps = np.flatnonzero(np.diff(steps) != 1)
+    return int(gaps[0]) + 1 if len(gaps) else len(steps)
 
-    g_a = evaluate_colregs(
-        Kinematics.from_frame(series, "own_"),
-        Kinematics.from_frame(series, "target_"),
-        params.colregs,
-    )
-    length_m, breadth_m, draught_m, defaulted = _target_dimensions(
-        tracks.vessels, encounter.target_mmsi, params.replay.target_defaults
-    )
-    estimator = _Estimator(
-        chart=chart,
-        params=params.manoeuvrability,
-        length_m=length_m,
-        breadth_m=breadth_m,
-        draught_m=draught_m,
-        reassess_steps=max(1, round(params.replay.reassess_every_s / tracks.step_s)),
-    )
-    restricted_statuses = params.replay.restricted_nav_statuses
-    verdicts: list[Rule9Assessment] = []
-    runs: dict[tuple[Role, int | None, Restriction], Rule9Assessment] = {}
-    estimates: list[Restriction] = []
-    assessed_at: list[pd.Timestamp] = []
-    trigger_assessment: ManoeuvrabilityAssessment | None = None
-    nav_statuses = [_nav_status(v) for v in series["target_nav_status"].tolist()]
-    timestamps = series["timestamp"].tolist()
-    # The chart lives in the local frame, so the arcs start from the grid course.
-    target_state = {
-        name: series[f"target_{column}"].to_numpy(dtype=float)
+
+def _state(series: pd.DataFrame, prefix: str) -> dict[str, np.ndarray]:
+    """A vessel's state arrays for the estimator: the chart lives in the local frame, so the
+    arcs start from the grid course."""
+    return {
+        name: series[f"{prefix}{column}"].to_numpy(dtype=float)
         for name, column in (
             ("north_m", "north_m"),
             ("east_m", "east_m"),
@@ -398,120 +479,447 @@ def evaluate_encounter(
             ("speed_mps", "speed_mps"),
         )
     }
-    for row, (own_role, nav_status) in enumerate(zip(g_a.own_role, nav_statuses, strict=True)):
-        reaches_d3 = own_role is Role.STAND_ON and nav_status not in restricted_statuses
-        assessment = estimator.at(target_state, row, needed=reaches_d3)
-        if row == 0:
-            trigger_assessment = assessment
-        # G_d depends on these three observations only; most steps repeat the last ones.
-        key = (own_role, nav_status, assessment.restriction)
-        if key not in runs:
-            runs[key] = assess_rule9(*key, restricted_statuses)
-        verdicts.append(runs[key])
-        estimates.append(assessment.restriction)
-        assessed_at.append(timestamps[estimator.assessed_row])
-    assert trigger_assessment is not None  # the trigger step is always in the series
 
-    series["beta_deg"] = g_a.beta_deg
-    series["beta_prime_deg"] = g_a.beta_prime_deg
-    series["situation"] = [s.value for s in g_a.situation]
-    series["own_role_colregs"] = [r.value for r in g_a.own_role]
-    series["target_role_colregs"] = [r.value for r in g_a.target_role]
-    series["target_reports_restricted"] = [s in restricted_statuses for s in nav_statuses]
-    series["target_estimated_restricted"] = [e.value for e in estimates]
-    series["restricted_assessed_utc"] = assessed_at
-    series["automaton_state"] = [v.final_state.value for v in verdicts]
-    series["automaton_path"] = [v.path_text for v in verdicts]
-    series["rule9_applied"] = [v.rule9_applied for v in verdicts]
-    series["own_role_final"] = [v.own_role_final.value for v in verdicts]
 
-    trigger = series.iloc[0]
-    verdict = verdicts[0]
-    target_role_colregs = g_a.target_role[0]
-    target_role_final = (
-        target_role_colregs.inverted() if verdict.rule9_applied else target_role_colregs
+def _mmsi_list(mmsis: Sequence[int]) -> str:
+    return ";".join(str(m) for m in mmsis)
+
+
+def _joined(values: Sequence[Any]) -> str:
+    return ";".join(str(v) for v in values)
+
+
+@dataclass(frozen=True)
+class _PairSteps:
+    """Per-step results of one pair in vessel order (a, b): the evaluation behind its rows."""
+
+    series: pd.DataFrame  # from the trigger to the pass, columns own_* = a, target_* = b
+    g_a: ColregsEvaluation
+    held: ColregsEvaluation  # the trigger's situation, repeated
+    verdicts: list[PairVerdict]
+    estimates: tuple[list[Restriction], list[Restriction]]
+    assessed_row: tuple[list[int], list[int]]
+    trigger_assessments: tuple[ManoeuvrabilityAssessment, ManoeuvrabilityAssessment]
+
+
+def _pair_steps(
+    series: pd.DataFrame,
+    dimensions: tuple[VesselDimensions, VesselDimensions],
+    chart: Chart | None,
+    params: ReplayRunParams,
+    step_s: float,
+) -> _PairSteps:
+    """G_a, the estimates and G_d of both seats at every step of ``series`` (a = own_)."""
+    g_a = evaluate_colregs(
+        Kinematics.from_frame(series, "own_"),
+        Kinematics.from_frame(series, "target_"),
+        params.colregs,
     )
-    give_way = [
-        side
-        for side, role in (("own", verdict.own_role_final), ("target", target_role_final))
-        if role is Role.GIVE_WAY
-    ]
-
-    # The actual closest approach: over the whole encounter, and the first one after the trigger
-    # ends the window in which the give-way vessel should have acted.
-    min_row = int(full["range_m"].to_numpy().argmin())
-    after = full[full["step"] >= encounter.trigger_step]
-    cpa_row = int(after["range_m"].to_numpy().argmin())
-    window = after.iloc[: cpa_row + 1]
-    acted: bool | None = None
-    if give_way:
-        acted = all(
-            _acted(
-                window[f"{side}_course_deg"].to_numpy(dtype=float),
-                window[f"{side}_sog_kn"].to_numpy(dtype=float),
-                params.replay,
+    rows = len(series)
+    held = ColregsEvaluation(
+        **{
+            name: np.repeat(getattr(g_a, name)[:1], rows)
+            for name in ("situation", "own_role", "target_role", "own_overtaking", "ambiguous")
+        },
+        basis=np.repeat(g_a.basis[:1], rows),
+        beta_deg=g_a.beta_deg,
+        beta_prime_deg=g_a.beta_prime_deg,
+        closing=g_a.closing,
+    )
+    situation = held.situation[0]
+    roles = (held.own_role[0], held.target_role[0])
+    statuses = params.replay.restricted_nav_statuses
+    reassess = max(1, round(params.replay.reassess_every_s / step_s))
+    estimators = tuple(
+        _Estimator(chart, params.manoeuvrability, dims, reassess) for dims in dimensions
+    )
+    states = (_state(series, "own_"), _state(series, "target_"))
+    nav = (
+        [_nav_status(v) for v in series["own_nav_status"].tolist()],
+        [_nav_status(v) for v in series["target_nav_status"].tolist()],
+    )
+    estimates: tuple[list[Restriction], list[Restriction]] = ([], [])
+    assessed_row: tuple[list[int], list[int]] = ([], [])
+    verdicts: list[PairVerdict] = []
+    cache: dict[tuple[Any, ...], PairVerdict] = {}
+    trigger: list[ManoeuvrabilityAssessment] = []
+    for row in range(rows):
+        for vessel in (0, 1):
+            # G_d reaches D3 about this vessel when she gives way and reports no restriction.
+            reaches_d3 = roles[vessel] is Role.GIVE_WAY and (
+                nav_status_finding(nav[vessel][row], statuses) is not Finding.TRUE
             )
-            for side in give_way
-        )
+            assessment = estimators[vessel].at(states[vessel], row, needed=reaches_d3)
+            if row == 0:
+                trigger.append(assessment)
+            estimates[vessel].append(assessment.restriction)
+            assessed_row[vessel].append(estimators[vessel].assessed_row)
+        key = (nav[0][row], nav[1][row], estimates[0][row], estimates[1][row])
+        if key not in cache:
+            cache[key] = decide_pair(situation, roles, (key[0], key[1]), (key[2], key[3]), statuses)
+        verdicts.append(cache[key])
+    return _PairSteps(
+        series=series,
+        g_a=g_a,
+        held=held,
+        verdicts=verdicts,
+        estimates=estimates,
+        assessed_row=assessed_row,
+        trigger_assessments=(trigger[0], trigger[1]),
+    )
 
-    tcpa_s = float(trigger["tcpa_s"])
-    own_vn, own_ve = velocity_mps(trigger["own_speed_mps"], trigger["own_cog_grid_deg"])
-    tgt_vn, tgt_ve = velocity_mps(trigger["target_speed_mps"], trigger["target_cog_grid_deg"])
-    vessels = tracks.vessels
-    summary = EncounterSummary(
-        encounter_id=encounter.encounter_id,
-        own_mmsi=encounter.own_mmsi,
-        target_mmsi=encounter.target_mmsi,
-        own_name=_text_or_none(vessels["name"].get(encounter.own_mmsi))
-        if "name" in vessels.columns
-        else None,
-        target_name=_text_or_none(vessels["name"].get(encounter.target_mmsi))
-        if "name" in vessels.columns
-        else None,
+
+def _rests_on_defaults(verdict: PairVerdict, dimensions: tuple[VesselDimensions, ...]) -> bool:
+    """True when an estimate for a vessel with defaulted dimensions entered G_d (d3)."""
+    about = ((verdict.seat_b, dimensions[0]), (verdict.seat_a, dimensions[1]))
+    return any(seat.d3 is not Finding.NOT_EVALUATED and dims.defaulted for seat, dims in about)
+
+
+@dataclass(frozen=True)
+class _Audit:
+    """The pass and both vessels' conduct up to the closest approach (vessel order a, b)."""
+
+    covers_cpa: bool
+    min_separation_m: float | None
+    cpa_utc: pd.Timestamp | None
+    conducts: tuple[Conduct, Conduct]
+    before_cpa_s: tuple[float | None, float | None]
+
+
+def _audit(window: pd.DataFrame, params: ReplayParams, step_s: float) -> _Audit:
+    seen = passage(window["range_m"].to_numpy(), window["tcpa_s"].to_numpy())
+    if not seen.covers_cpa or seen.cpa_row is None:
+        return _Audit(False, None, None, (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT), (None, None))
+    until = window.iloc[: seen.cpa_row + 1]
+    conduct_params = ConductParams(
+        params.course_change_deg, params.speed_change_frac, params.course_judged_above_kn
+    )
+    conducts = tuple(
+        conduct(
+            until[f"{prefix}course_deg"].to_numpy(dtype=float),
+            until[f"{prefix}sog_kn"].to_numpy(dtype=float),
+            conduct_params,
+        )
+        for prefix in ("own_", "target_")
+    )
+    before = tuple(
+        None if c.action_row is None else (seen.cpa_row - c.action_row) * step_s for c in conducts
+    )
+    return _Audit(
+        covers_cpa=True,
+        min_separation_m=seen.min_separation_m,
+        cpa_utc=window["timestamp"].iloc[seen.cpa_row],
+        conducts=(conducts[0], conducts[1]),
+        before_cpa_s=(before[0], before[1]),
+    )
+
+
+def evaluate_pair(
+    tracks: Tracks,
+    encounter: Encounter,
+    seats: Sequence[int],
+    chart: Chart | None,
+    params: ReplayRunParams,
+) -> PairOutcome:
+    """One triggered pair, evaluated once: its pairs.csv row and the rows of ``seats`` (the
+    own-ship MMSIs to report). ``encounter`` may be either seat's."""
+    if encounter.trigger_step is None or encounter.tcpa_s_at_trigger is None:
+        raise ValueError(f"encounter {encounter.encounter_id} never triggered")
+    a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
+    oriented = dataclasses.replace(encounter, own_mmsi=a, target_mmsi=b)
+    step_s = tracks.step_s
+    horizon = math.ceil((encounter.tcpa_s_at_trigger + params.replay.tcpa_act_s) / step_s)
+    both = pair_tracks(tracks, (a, b))
+    full = encounter_series(
+        both, oriented, to_step=max(encounter.end_step, encounter.trigger_step + horizon)
+    )
+    full = full.iloc[: _contiguous_rows(full["step"].to_numpy())].reset_index(drop=True)
+    window = full[full["step"] >= encounter.trigger_step].reset_index(drop=True)
+    audit = _audit(window, params.replay, step_s)
+    # G_a and G_d run until the pair is past (the step before it opens), as in the paper.
+    opening = np.flatnonzero(window["tcpa_s"].to_numpy()[1:] < 0.0)
+    series = window.iloc[: int(opening[0]) + 1 if len(opening) else len(window)]
+
+    dimensions = (
+        vessel_dimensions(_static(tracks.vessels, a), params.replay.dimension_overrides),
+        vessel_dimensions(_static(tracks.vessels, b), params.replay.dimension_overrides),
+    )
+    steps = _pair_steps(series, dimensions, chart, params, step_s)
+    names = tuple(
+        _text_or_none(tracks.vessels["name"].get(m)) if "name" in tracks.vessels.columns else None
+        for m in (a, b)
+    )
+    trigger = series.iloc[0]
+    vessels = tuple(
+        VesselAtTrigger(
+            mmsi=mmsi,
+            name=names[i],
+            dimensions=dimensions[i],
+            nav_status=_nav_status(trigger[f"{prefix}nav_status"]),
+            course_deg=float(trigger[f"{prefix}course_deg"]),
+            speed_kn=float(trigger[f"{prefix}sog_kn"]),
+            estimated_restricted=steps.estimates[i][0],
+            conduct=audit.conducts[i],
+            action_before_cpa_s=audit.before_cpa_s[i],
+        )
+        for i, (mmsi, prefix) in enumerate(((a, "own_"), (b, "target_")))
+    )
+    pair_summary = _pair_summary(encounter, (vessels[0], vessels[1]), steps, audit, seats)
+    outcomes = []
+    for own in sorted(set(seats)):
+        flip = own == b
+        outcomes.append(
+            _seat_outcome(
+                pair_summary,
+                steps,
+                (vessels[0], vessels[1]),
+                full,
+                flip,
+                encounter,
+                params,
+            )
+        )
+    return PairOutcome(summary=pair_summary, seats=tuple(outcomes))
+
+
+def _pair_summary(
+    encounter: Encounter,
+    vessels: tuple[VesselAtTrigger, VesselAtTrigger],
+    steps: _PairSteps,
+    audit: _Audit,
+    seats: Sequence[int],
+) -> PairSummary:
+    verdict = steps.verdicts[0]
+    trigger = steps.series.iloc[0]
+    a, b = vessels
+    give_way = _with_role(vessels, verdict, Role.GIVE_WAY)
+    stand_on = _with_role(vessels, verdict, Role.STAND_ON)
+    return PairSummary(
+        pair_id=f"{encounter.start:%Y%m%dT%H%M%S}-{a.mmsi}+{b.mmsi}",
+        mmsi_a=a.mmsi,
+        mmsi_b=b.mmsi,
+        name_a=a.name,
+        name_b=b.name,
+        seats_reported=_mmsi_list(sorted(set(seats))),
         start_utc=encounter.start,
         trigger_utc=trigger["timestamp"],
         end_utc=encounter.end,
-        situation=g_a.situation[0],
-        own_role_colregs=g_a.own_role[0],
-        target_role_colregs=target_role_colregs,
-        target_nav_status=_nav_status(trigger["target_nav_status"]),
-        target_reports_restricted=nav_statuses[0] in restricted_statuses,
-        target_estimated_restricted=estimates[0],
+        situation=verdict.situation,
+        situation_ambiguous=bool(steps.held.ambiguous[0]),
+        situation_basis=steps.held.basis[0],
+        role_colregs_a=verdict.role_colregs[0],
+        role_colregs_b=verdict.role_colregs[1],
+        nav_status_a=a.nav_status,
+        nav_status_b=b.nav_status,
+        estimated_restricted_a=a.estimated_restricted,
+        estimated_restricted_b=b.estimated_restricted,
+        automaton_path_a=verdict.seat_a.path_text,
+        automaton_path_b=verdict.seat_b.path_text,
         rule9_applied=verdict.rule9_applied,
-        own_role_final=verdict.own_role_final,
-        automaton_path=verdict.path_text,
+        deciding_rule=verdict.deciding_rule,
+        both_restricted=verdict.both_restricted,
+        role_final_a=verdict.role_final[0],
+        role_final_b=verdict.role_final[1],
+        give_way_vessels=_mmsi_list([v.mmsi for v in give_way]),
+        verdict_rests_on_defaults=_rests_on_defaults(verdict, (a.dimensions, b.dimensions)),
         range_m_at_trigger=float(trigger["range_m"]),
         cpa_m=float(trigger["cpa_m"]),
-        tcpa_s=tcpa_s,
-        actual_min_separation_m=float(full.at[min_row, "range_m"]),
-        actual_min_separation_utc=full.at[min_row, "timestamp"],
-        give_way_vessel="+".join(give_way) if give_way else "none",
-        give_way_vessel_acted=acted,
-        own_course_deg_at_trigger=float(trigger["own_course_deg"]),
-        own_speed_kn_at_trigger=float(trigger["own_sog_kn"]),
-        target_course_deg_at_trigger=float(trigger["target_course_deg"]),
-        target_speed_kn_at_trigger=float(trigger["target_sog_kn"]),
-        target_length_m=length_m,
-        target_breadth_m=breadth_m,
-        target_draught_m=draught_m,
-        target_dimensions_defaulted=defaulted,
+        tcpa_s=float(trigger["tcpa_s"]),
+        data_covers_cpa=audit.covers_cpa,
+        actual_min_separation_m=audit.min_separation_m,
+        actual_min_separation_utc=audit.cpa_utc,
+        give_way_vessel_acted=all_of(v.conduct.changed for v in give_way) if give_way else None,
+        give_way_action=_joined([v.conduct.action.value for v in give_way]),
+        action_before_cpa_s=_joined([_seconds(v.action_before_cpa_s) for v in give_way]),
+        stand_on_vessel_kept_course=(
+            all_of(negated(v.conduct.changed) for v in stand_on) if stand_on else None
+        ),
+        action_a=a.conduct.action,
+        action_b=b.conduct.action,
+        length_m_a=a.dimensions.length_m,
+        breadth_m_a=a.dimensions.breadth_m,
+        draught_m_a=a.dimensions.draught_m,
+        defaulted_dimensions_a=a.dimensions.defaulted_text,
+        length_m_b=b.dimensions.length_m,
+        breadth_m_b=b.dimensions.breadth_m,
+        draught_m_b=b.dimensions.draught_m,
+        defaulted_dimensions_b=b.dimensions.defaulted_text,
     )
+
+
+def _with_role(
+    vessels: tuple[VesselAtTrigger, VesselAtTrigger], verdict: PairVerdict, role: Role
+) -> list[VesselAtTrigger]:
+    return [v for v, final in zip(vessels, verdict.role_final, strict=True) if final is role]
+
+
+def _seconds(value: float | None) -> str:
+    return "" if value is None else f"{value:g}"
+
+
+def _seat_series(steps: _PairSteps, flip: bool, statuses: frozenset[int]) -> pd.DataFrame:
+    """The time series seen from one seat: own_* is vessel b when ``flip``, else vessel a."""
+    series = steps.series
+    own_prefix, target_prefix = ("target_", "own_") if flip else ("own_", "target_")
+    own, target = (1, 0) if flip else (0, 1)
+    timestamps = series["timestamp"].tolist()
+    seats = [(v.seat_b, v.seat_a) if flip else (v.seat_a, v.seat_b) for v in steps.verdicts]
+    columns: dict[str, Any] = {
+        "step": series["step"].to_numpy(),
+        "timestamp": series["timestamp"].to_numpy(),
+    }
+    for name in SERIES_VESSEL_FIELDS:
+        columns[f"own_{name}"] = series[f"{own_prefix}{name}"].to_numpy()
+        columns[f"target_{name}"] = series[f"{target_prefix}{name}"].to_numpy()
+    for name in ("range_m", "cpa_m", "tcpa_s"):
+        columns[name] = series[name].to_numpy()
+    bearings = (
+        (steps.g_a.beta_prime_deg, steps.g_a.beta_deg)
+        if flip
+        else (
+            steps.g_a.beta_deg,
+            steps.g_a.beta_prime_deg,
+        )
+    )
+    columns["beta_deg"], columns["beta_prime_deg"] = bearings
+    roles = (
+        (steps.held.target_role, steps.held.own_role)
+        if flip
+        else (
+            steps.held.own_role,
+            steps.held.target_role,
+        )
+    )
+    columns |= {
+        "situation_now": [s.value for s in steps.g_a.situation],
+        "situation_now_ambiguous": steps.g_a.ambiguous,
+        "situation": [s.value for s in steps.held.situation],
+        "own_role_colregs": [r.value for r in roles[0]],
+        "target_role_colregs": [r.value for r in roles[1]],
+    }
+    for prefix, vessel in (("own_", own), ("target_", target)):
+        status = series[f"{'target_' if vessel else 'own_'}nav_status"].tolist()
+        columns[f"{prefix}reports_restricted"] = [
+            nav_status_finding(_nav_status(v), statuses) is Finding.TRUE for v in status
+        ]
+        columns[f"{prefix}estimated_restricted"] = [e.value for e in steps.estimates[vessel]]
+        columns[f"{prefix}assessed_utc"] = [timestamps[r] for r in steps.assessed_row[vessel]]
+    columns |= {
+        "automaton_state": [own_seat.final_state.value for own_seat, _ in seats],
+        "automaton_path": [own_seat.path_text for own_seat, _ in seats],
+        "target_seat_automaton_path": [other.path_text for _, other in seats],
+        "rule9_applied": [v.rule9_applied for v in steps.verdicts],
+        "deciding_rule": [v.deciding_rule.value for v in steps.verdicts],
+        "own_role_final": [v.role_final[own].value for v in steps.verdicts],
+        "target_role_final": [v.role_final[target].value for v in steps.verdicts],
+    }
+    return pd.DataFrame(columns)[list(SERIES_COLUMNS)]
+
+
+def _give_way_side(own_role: Role, target_role: Role) -> str:
+    sides = [
+        side for side, role in (("own", own_role), ("target", target_role)) if role is Role.GIVE_WAY
+    ]
+    return "+".join(sides) if sides else "none"
+
+
+def _seat_outcome(
+    pair: PairSummary,
+    steps: _PairSteps,
+    vessels: tuple[VesselAtTrigger, VesselAtTrigger],
+    full: pd.DataFrame,
+    flip: bool,
+    encounter: Encounter,
+    params: ReplayRunParams,
+) -> EncounterOutcome:
+    """The encounters.csv row, series and figure data of one seat of a pair."""
+    own_index, target_index = (1, 0) if flip else (0, 1)
+    own, target = vessels[own_index], vessels[target_index]
+    verdict = steps.verdicts[0]
+    own_seat, other_seat = (
+        (verdict.seat_b, verdict.seat_a) if flip else (verdict.seat_a, verdict.seat_b)
+    )
+    own_final, target_final = verdict.role_final[own_index], verdict.role_final[target_index]
+    own_prefix, target_prefix = ("target_", "own_") if flip else ("own_", "target_")
+    trigger = steps.series.iloc[0]
+    summary = EncounterSummary(
+        encounter_id=f"{encounter.start:%Y%m%dT%H%M%S}-{own.mmsi}-{target.mmsi}",
+        pair_id=pair.pair_id,
+        own_mmsi=own.mmsi,
+        target_mmsi=target.mmsi,
+        own_name=own.name,
+        target_name=target.name,
+        start_utc=pair.start_utc,
+        trigger_utc=pair.trigger_utc,
+        end_utc=pair.end_utc,
+        situation=pair.situation,
+        situation_ambiguous=pair.situation_ambiguous,
+        situation_basis=pair.situation_basis,
+        own_role_colregs=verdict.role_colregs[own_index],
+        target_role_colregs=verdict.role_colregs[target_index],
+        own_nav_status=own.nav_status,
+        target_nav_status=target.nav_status,
+        target_reports_restricted=nav_status_finding(
+            target.nav_status, params.replay.restricted_nav_statuses
+        )
+        is Finding.TRUE,
+        target_estimated_restricted=target.estimated_restricted,
+        own_estimated_restricted=own.estimated_restricted,
+        automaton_path=own_seat.path_text,
+        target_seat_automaton_path=other_seat.path_text,
+        rule9_applied=pair.rule9_applied,
+        deciding_rule=pair.deciding_rule,
+        both_restricted=pair.both_restricted,
+        own_role_final=own_final,
+        target_role_final=target_final,
+        give_way_vessel=_give_way_side(own_final, target_final),
+        give_way_vessels=pair.give_way_vessels,
+        verdict_rests_on_defaults=pair.verdict_rests_on_defaults,
+        range_m_at_trigger=pair.range_m_at_trigger,
+        cpa_m=pair.cpa_m,
+        tcpa_s=pair.tcpa_s,
+        data_covers_cpa=pair.data_covers_cpa,
+        actual_min_separation_m=pair.actual_min_separation_m,
+        actual_min_separation_utc=pair.actual_min_separation_utc,
+        give_way_vessel_acted=pair.give_way_vessel_acted,
+        give_way_action=pair.give_way_action,
+        action_before_cpa_s=pair.action_before_cpa_s,
+        stand_on_vessel_kept_course=pair.stand_on_vessel_kept_course,
+        own_course_deg_at_trigger=own.course_deg,
+        own_speed_kn_at_trigger=own.speed_kn,
+        target_course_deg_at_trigger=target.course_deg,
+        target_speed_kn_at_trigger=target.speed_kn,
+        own_length_m=own.dimensions.length_m,
+        own_breadth_m=own.dimensions.breadth_m,
+        own_draught_m=own.dimensions.draught_m,
+        own_dimensions_defaulted=own.dimensions.defaulted_text,
+        target_length_m=target.dimensions.length_m,
+        target_breadth_m=target.dimensions.breadth_m,
+        target_draught_m=target.dimensions.draught_m,
+        target_dimensions_defaulted=target.dimensions.defaulted_text,
+    )
+    tcpa_s = pair.tcpa_s
+
+    def at_tcpa(prefix: str) -> tuple[float, float]:
+        v_north, v_east = velocity_mps(
+            trigger[f"{prefix}speed_mps"], trigger[f"{prefix}cog_grid_deg"]
+        )
+        return (
+            float(trigger[f"{prefix}north_m"] + v_north * tcpa_s),
+            float(trigger[f"{prefix}east_m"] + v_east * tcpa_s),
+        )
+
+    def track(prefix: str) -> pd.DataFrame:
+        return full[[f"{prefix}north_m", f"{prefix}east_m"]].set_axis(["north_m", "east_m"], axis=1)
+
     return EncounterOutcome(
         summary=summary,
-        series=series[list(SERIES_COLUMNS)],
-        own_track=full[["own_north_m", "own_east_m"]].set_axis(["north_m", "east_m"], axis=1),
-        target_track=full[["target_north_m", "target_east_m"]].set_axis(
-            ["north_m", "east_m"], axis=1
-        ),
-        own_at_tcpa_m=(
-            float(trigger["own_north_m"] + own_vn * tcpa_s),
-            float(trigger["own_east_m"] + own_ve * tcpa_s),
-        ),
-        target_at_tcpa_m=(
-            float(trigger["target_north_m"] + tgt_vn * tcpa_s),
-            float(trigger["target_east_m"] + tgt_ve * tcpa_s),
-        ),
-        assessment=trigger_assessment,
+        series=_seat_series(steps, flip, params.replay.restricted_nav_statuses),
+        own_track=track(own_prefix),
+        target_track=track(target_prefix),
+        own_at_tcpa_m=at_tcpa(own_prefix),
+        target_at_tcpa_m=at_tcpa(target_prefix),
+        assessment=steps.trigger_assessments[target_index],
     )
 
 
@@ -524,7 +932,19 @@ def _counts(tracks: Tracks, search: EncounterSearch) -> ReplayCounts:
         candidate_pairs=len(pairs),
         encounters=len(search.encounters),
         triggered=len(search.triggered),
+        triggered_pairs=len(triggered_pairs(search)),
     )
+
+
+def triggered_pairs(search: EncounterSearch) -> list[tuple[Encounter, tuple[int, ...]]]:
+    """Each triggered pair once, with the own-ship MMSIs of its reported seats, by start."""
+    seats: dict[tuple[int, int, int], list[Encounter]] = {}
+    for encounter in search.triggered:
+        a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
+        seats.setdefault((encounter.start_step, a, b), []).append(encounter)
+    return [
+        (found[0], tuple(sorted(e.own_mmsi for e in found))) for _, found in sorted(seats.items())
+    ]
 
 
 def _no_overlap(chart_paths: Sequence[Path], positions: pd.DataFrame) -> ChartError:
@@ -567,7 +987,7 @@ def build_manifest(
     params: ReplayRunParams,
     tracks: Tracks,
     counts: ReplayCounts,
-    outcomes: tuple[EncounterOutcome, ...],
+    pairs: tuple[PairOutcome, ...],
 ) -> dict[str, Any]:
     """The content of run.json."""
     return {
@@ -581,13 +1001,7 @@ def build_manifest(
         "ledger_balanced": ledger.balanced,
         "tracks": jsonable(tracks.stats),
         "counts": jsonable(counts),
-        "verdicts": {
-            "rule9_applied": sum(o.summary.rule9_applied for o in outcomes),
-            "target_estimated_restricted": {
-                value.value: sum(o.summary.target_estimated_restricted is value for o in outcomes)
-                for value in Restriction
-            },
-        },
+        "verdicts": verdict_counts(pairs),
     }
 
 
@@ -627,11 +1041,11 @@ def run_replay(
     tracks = build_tracks(positions, frame, params.replay, params.colregs.course_source)
     ledger = _ledger_with_tracks(data.ledger, tracks)
     search = find_encounters(tracks, params.replay, params.own_mmsi or None)
-    triggered = search.triggered
-    outcomes: list[EncounterOutcome] = []
-    with progress_bar("encounters", len(triggered), progress_enabled(quiet)) as bar:
-        for encounter in triggered:
-            outcomes.append(evaluate_encounter(tracks, encounter, chart, params))
+    to_evaluate = triggered_pairs(search)
+    outcomes: list[PairOutcome] = []
+    with progress_bar("pairs", len(to_evaluate), progress_enabled(quiet)) as bar:
+        for encounter, seats in to_evaluate:
+            outcomes.append(evaluate_pair(tracks, encounter, seats, chart, params))
             bar.advance()
     counts = _counts(tracks, search)
     target = out_dir if out_dir is not None else default_out_dir(query.name)
@@ -643,11 +1057,35 @@ def run_replay(
         out_dir=target,
         frame=frame,
         params=params,
-        encounters=tuple(outcomes),
+        pairs=tuple(outcomes),
         counts=counts,
         manifest=manifest,
         files=(),
     )
-    with progress_bar("reports", len(outcomes), progress_enabled(quiet)) as bar:
+    with progress_bar("reports", len(result.encounters), progress_enabled(quiet)) as bar:
         files = write_replay_reports(result, chart, plots, bar)
     return dataclasses.replace(result, files=files)
+
+
+def verdict_counts(pairs: Sequence[PairOutcome]) -> dict[str, Any]:
+    """The pairs' verdicts counted for run.json: by situation, deciding rule and audit fact."""
+
+    def count(values: Sequence[Any]) -> dict[str, int]:
+        texts = ["" if v is None else str(getattr(v, "value", v)).lower() for v in values]
+        return {key: texts.count(key) for key in sorted(set(texts))}
+
+    summaries = [p.summary for p in pairs]
+    return {
+        "pairs": len(summaries),
+        "situation": count([s.situation for s in summaries]),
+        "situation_ambiguous": sum(s.situation_ambiguous for s in summaries),
+        "deciding_rule": count([s.deciding_rule for s in summaries]),
+        "rule9_applied": sum(s.rule9_applied for s in summaries),
+        "both_restricted": sum(s.both_restricted for s in summaries),
+        "verdict_rests_on_defaults": sum(s.verdict_rests_on_defaults for s in summaries),
+        "data_covers_cpa": sum(s.data_covers_cpa for s in summaries),
+        "give_way_vessel_acted": count([s.give_way_vessel_acted for s in summaries]),
+        "estimated_restricted": count(
+            [e for s in summaries for e in (s.estimated_restricted_a, s.estimated_restricted_b)]
+        ),
+    }

@@ -27,15 +27,6 @@ class CourseSource(StrEnum):
 
 
 @dataclass(frozen=True)
-class TargetDimensions:
-    """Dimensions used for a target that does not report them."""
-
-    length_m: float
-    breadth_m: float
-    draught_m: float
-
-
-@dataclass(frozen=True)
 class ReplayParams:
     """The ``[replay]`` table.
 
@@ -49,14 +40,16 @@ class ReplayParams:
       ``0 <= TCPA <= tcpa_act_s`` and ``CPA < cpa_req_m``.
     - ``course_change_deg``, ``speed_change_frac``: a vessel "acted" when her course changed by
       at least this many degrees, or her speed by at least this fraction, before CPA.
+    - ``course_judged_above_kn``: a course change counts only at speeds of at least this much,
+      where COG means something (at 0.5 kn it is mostly GPS noise).
     - ``restricted_nav_statuses``: AIS navigational status codes that mean "restricted
       manoeuvrability" for event d2 of the rule 9 automaton (3 restricted manoeuvrability,
       4 constrained by her draught).
     - ``reassess_every_s``: after the trigger, a manoeuvrability estimate is made again only
       where G_d reaches D3 and the last one is at least this old (see ``replay.py``).
-    - ``default_length_m``, ``default_breadth_m``, ``default_draught_m``: used for a target
-      that does not report the dimension; the means of the paper's Table 1 (50.1 m, 9.2 m,
-      3.2 m).
+    - ``default_length_m``, ``default_breadth_m``, ``default_draught_m``: when given, used for
+      every vessel that does not report the dimension; when not (the default), the value comes
+      from the table of ``vessel_defaults.py`` by mobile type and ship type.
     """
 
     step_s: float = 1.0
@@ -68,17 +61,20 @@ class ReplayParams:
     cpa_req_m: float = 150.0
     course_change_deg: float = 15.0
     speed_change_frac: float = 0.25
+    course_judged_above_kn: float = 2.0
     restricted_nav_statuses: frozenset[int] = frozenset({3, 4})
     reassess_every_s: float = 10.0
-    default_length_m: float = 50.1
-    default_breadth_m: float = 9.2
-    default_draught_m: float = 3.2
+    default_length_m: float | None = None
+    default_breadth_m: float | None = None
+    default_draught_m: float | None = None
 
     @property
-    def target_defaults(self) -> TargetDimensions:
-        return TargetDimensions(
-            self.default_length_m, self.default_breadth_m, self.default_draught_m
-        )
+    def dimension_overrides(self) -> dict[str, float | None]:
+        return {
+            "length_m": self.default_length_m,
+            "breadth_m": self.default_breadth_m,
+            "draught_m": self.default_draught_m,
+        }
 
     def __post_init__(self) -> None:
         positive = (
@@ -90,15 +86,19 @@ class ReplayParams:
             "course_change_deg",
             "speed_change_frac",
             "reassess_every_s",
-            "default_length_m",
-            "default_breadth_m",
-            "default_draught_m",
         )
         for name in positive:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0.0):
                 raise ParameterError(f"[replay] {name} = {value!r}: give a positive number")
-        for name in ("min_sog_kn", "tcpa_act_s"):
+        for name in ("default_length_m", "default_breadth_m", "default_draught_m"):
+            value = getattr(self, name)
+            if value is not None and not (math.isfinite(value) and value > 0.0):
+                raise ParameterError(
+                    f"[replay] {name} = {value!r}: give a positive number, or leave it out to "
+                    "take defaults by ship type"
+                )
+        for name in ("min_sog_kn", "tcpa_act_s", "course_judged_above_kn"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
                 raise ParameterError(f"[replay] {name} = {value!r}: give a number >= 0")

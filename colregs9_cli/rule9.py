@@ -13,15 +13,38 @@ and the transition function ``TRANSITIONS`` (exactly the figure's six arrows):
     D2 –d2→  D4    D2 –¬d2→ D3
     D3 –d3→  D4    D3 –¬d3→ D1
 
-Events: d1 the target needs to give way (own ship's COLREGs role is stand-on); d2 the target's
-AIS navigational status is in the restricted set (``ReplayParams.restricted_nav_statuses``,
-the ``[replay]`` table; default {3, 4}); d3 the manoeuvrability estimator says the target is
-restricted. The estimator's "unknown" is ¬d3, recorded as ``unknown`` and never as "not
-restricted"; so is a missing nav status for d2.
+Events, as in the paper: d1 the target needs to give way under rules 13–15 (a crossing or
+overtaking in which own ship stands on, and every head-on); d2 the target's AIS navigational
+status is in the restricted set (``ReplayParams.restricted_nav_statuses``, default {3, 4});
+d3 the manoeuvrability estimator says the target is restricted. The estimator's "unknown" is
+¬d3, recorded as ``unknown`` and never as "not restricted"; so is a missing nav status for d2.
+D4 means the target is not expected to give way: she stands on and own ship gives way.
 
 One assessment runs the automaton from D1 until it reaches a marked state after at least one
-transition. Own ship not stand-on gives the ¬d1 self-loop and the path ``D1>D1``; the other
-paths are ``D1>D2>D4``, ``D1>D2>D3>D4`` and ``D1>D2>D3>D1``.
+transition. A target that need not give way gives the ¬d1 self-loop and the path ``D1>D1``;
+the other paths are ``D1>D2>D4``, ``D1>D2>D3>D4`` and ``D1>D2>D3>D1``.
+
+The pair's final roles (``decide_pair``) combine the automaton of both seats (seat A asks
+whether B is restricted, seat B whether A is) with rules 13 and 18, so that both seats name
+the same give-way vessel(s). This module is the one place that decides them:
+
+1. No situation: no roles.
+2. Overtaking: rule 13 keeps the roles whatever either vessel reports or is estimated (rule 18
+   opens "except where Rules 9, 10 and 13 otherwise require"); the paths are still recorded.
+3. A vessel is restricted when the other seat's G_d reached D4 about her (she had to give
+   way and is restricted), or when her AIS status claims it (a status in the restricted set,
+   or not under command, restricted, constrained by her draught) even as the stand-on
+   vessel. Exactly one restricted vessel stands on and the other gives way; the deciding rule
+   is 9 when the estimator said so (d3: she can navigate safely only within the channel), 18
+   when her AIS status did.
+4. Both restricted: the rules 13–15 roles stay, flagged ``both_restricted``.
+5. Otherwise rule 18 where AIS says so: of a vessel not under command or restricted in her
+   ability to manoeuvre (status 2, 3), constrained by her draught (4), engaged in fishing (7)
+   and sailing (8), ranked in that order of rule 18, the lower-ranked vessel keeps out of the
+   way of the higher-ranked one. A missing or other status ranks as a power-driven vessel.
+6. Otherwise the roles of rules 14 and 15.
+
+The deciding rule is 13, 14 or 15 wherever rules 9 and 18 leave those roles unchanged.
 """
 
 from __future__ import annotations
@@ -30,7 +53,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import Enum, StrEnum
 
-from .colregs import Role
+from .colregs import Role, Situation
 
 
 class State(Enum):
@@ -106,12 +129,11 @@ def path_text(path: Iterable[State]) -> str:
 
 @dataclass(frozen=True)
 class Rule9Assessment:
-    """One run of G_d for an own ship / target pair at one step."""
+    """One run of G_d in one seat: own ship asks about the target."""
 
     path: tuple[State, ...]
     events: tuple[Event, ...]
-    own_role_colregs: Role
-    own_role_final: Role
+    target_role_colregs: Role
     d1: bool
     d2: Finding
     d3: Finding
@@ -126,23 +148,31 @@ class Rule9Assessment:
 
     @property
     def rule9_applied(self) -> bool:
+        """D4: the target is not expected to give way."""
         return self.final_state is State.D4
 
 
 _RESTRICTION_FINDINGS = {"true": Finding.TRUE, "false": Finding.FALSE, "unknown": Finding.UNKNOWN}
 
 
+def nav_status_finding(nav_status: int | None, restricted_nav_statuses: frozenset[int]) -> Finding:
+    """d2's condition: whether an AIS status is in the restricted set (unknown when missing)."""
+    if nav_status is None:
+        return Finding.UNKNOWN
+    return Finding.TRUE if int(nav_status) in restricted_nav_statuses else Finding.FALSE
+
+
 def assess_rule9(
-    own_role: Role,
+    target_role: Role,
     target_nav_status: int | None,
     target_restricted: str,
     restricted_nav_statuses: frozenset[int] = frozenset({3, 4}),
 ) -> Rule9Assessment:
     """Run G_d from D1 to a marked state.
 
-    ``target_restricted`` is the estimator's verdict, a
-    ``manoeuvrability.Restriction`` ("true", "false" or "unknown"; a ``StrEnum``, so plain
-    strings work too). D4 inverts own ship's role (stand-on becomes give-way).
+    ``target_role`` is the target's role under rules 13–15 (d1: she gives way).
+    ``target_restricted`` is the estimator's verdict, a ``manoeuvrability.Restriction``
+    ("true", "false" or "unknown"; a ``StrEnum``, so plain strings work too).
     """
     try:
         d3_finding = _RESTRICTION_FINDINGS[str(target_restricted)]
@@ -150,14 +180,8 @@ def assess_rule9(
         raise ValueError(
             f"target_restricted must be 'true', 'false' or 'unknown', not {target_restricted!r}"
         ) from None
-    d2_finding = (
-        Finding.UNKNOWN
-        if target_nav_status is None
-        else Finding.TRUE
-        if int(target_nav_status) in restricted_nav_statuses
-        else Finding.FALSE
-    )
-    d1 = own_role is Role.STAND_ON
+    d2_finding = nav_status_finding(target_nav_status, restricted_nav_statuses)
+    d1 = target_role is Role.GIVE_WAY
     # The event each state generates, from the observations.
     event_at = {
         State.D1: Event.D1 if d1 else Event.NOT_D1,
@@ -170,13 +194,140 @@ def assess_rule9(
         events.append(event_at[path[-1]])
         path.append(step(path[-1], events[-1]))
     visited = set(path)
-    final = path[-1]
     return Rule9Assessment(
         path=tuple(path),
         events=tuple(events),
-        own_role_colregs=own_role,
-        own_role_final=own_role.inverted() if final is State.D4 else own_role,
+        target_role_colregs=target_role,
         d1=d1,
         d2=d2_finding if State.D2 in visited else Finding.NOT_EVALUATED,
         d3=d3_finding if State.D3 in visited else Finding.NOT_EVALUATED,
+    )
+
+
+class DecidingRule(StrEnum):
+    """The rule that settled a pair's final roles."""
+
+    RULE_9 = "9"
+    RULE_13 = "13"
+    RULE_14 = "14"
+    RULE_15 = "15"
+    RULE_18 = "18"
+    NONE = ""
+
+
+# Rule 18's order of precedence by AIS navigational status; other codes and a missing status
+# rank as a power-driven vessel (0). A lower-ranked vessel keeps out of the way.
+RULE18_RANK: dict[int, int] = {2: 4, 3: 4, 4: 3, 7: 2, 8: 1}
+
+_STEERING_RULE = {
+    Situation.OVERTAKING: DecidingRule.RULE_13,
+    Situation.HEAD_ON: DecidingRule.RULE_14,
+    Situation.CROSSING: DecidingRule.RULE_15,
+    Situation.NONE: DecidingRule.NONE,
+}
+
+
+def rule18_rank(nav_status: int | None) -> int:
+    return 0 if nav_status is None else RULE18_RANK.get(int(nav_status), 0)
+
+
+@dataclass(frozen=True)
+class PairVerdict:
+    """A pair's final roles, the same from both seats.
+
+    Vessel ``a`` and vessel ``b`` in a fixed order; ``seat_a`` is G_d run by a about b, and
+    ``seat_b`` by b about a.
+    """
+
+    situation: Situation
+    role_colregs: tuple[Role, Role]
+    seat_a: Rule9Assessment
+    seat_b: Rule9Assessment
+    role_final: tuple[Role, Role]
+    deciding_rule: DecidingRule
+    both_restricted: bool
+
+    @property
+    def rule9_applied(self) -> bool:
+        return self.deciding_rule is DecidingRule.RULE_9
+
+    @property
+    def overridden_by_rule13(self) -> bool:
+        """G_d reached D4 in an overtaking, where rule 13 keeps the roles."""
+        return self.situation is Situation.OVERTAKING and (
+            self.seat_a.rule9_applied or self.seat_b.rule9_applied
+        )
+
+    def swapped(self) -> PairVerdict:
+        """The same verdict with the vessels in the other order."""
+        return PairVerdict(
+            situation=self.situation,
+            role_colregs=(self.role_colregs[1], self.role_colregs[0]),
+            seat_a=self.seat_b,
+            seat_b=self.seat_a,
+            role_final=(self.role_final[1], self.role_final[0]),
+            deciding_rule=self.deciding_rule,
+            both_restricted=self.both_restricted,
+        )
+
+
+def decide_pair(
+    situation: Situation,
+    role_colregs: tuple[Role, Role],
+    nav_status: tuple[int | None, int | None],
+    estimated_restricted: tuple[str, str],
+    restricted_nav_statuses: frozenset[int] = frozenset({3, 4}),
+) -> PairVerdict:
+    """The final roles of vessels a and b (module docstring), from both seats' G_d.
+
+    Each tuple holds vessel a's value, then vessel b's. ``estimated_restricted`` is each
+    vessel's estimator verdict (a ``Restriction`` or its string).
+    """
+    role_a, role_b = role_colregs
+    seat_a = assess_rule9(role_b, nav_status[1], estimated_restricted[1], restricted_nav_statuses)
+    seat_b = assess_rule9(role_a, nav_status[0], estimated_restricted[0], restricted_nav_statuses)
+    # A vessel is restricted when G_d reached D4 about her, or when she says so on AIS even
+    # as the stand-on vessel: then the other, if restricted too, cannot be made to stand on.
+    restricted = (
+        seat_b.rule9_applied or _claims_restriction(nav_status[0], restricted_nav_statuses),
+        seat_a.rule9_applied or _claims_restriction(nav_status[1], restricted_nav_statuses),
+    )
+    final = role_colregs
+    rule = _STEERING_RULE[situation]
+    if situation not in (Situation.NONE, Situation.OVERTAKING):
+        if restricted[0] != restricted[1]:
+            about_restricted = seat_b if restricted[0] else seat_a
+            by_restriction = (
+                (Role.STAND_ON, Role.GIVE_WAY) if restricted[0] else (Role.GIVE_WAY, Role.STAND_ON)
+            )
+            if by_restriction != final:
+                final = by_restriction
+                rule = (
+                    DecidingRule.RULE_9
+                    if about_restricted.d3 is Finding.TRUE
+                    else DecidingRule.RULE_18
+                )
+        elif not restricted[0]:
+            rank_a, rank_b = rule18_rank(nav_status[0]), rule18_rank(nav_status[1])
+            by_rank = (
+                (Role.STAND_ON, Role.GIVE_WAY)
+                if rank_a > rank_b
+                else (Role.GIVE_WAY, Role.STAND_ON)
+            )
+            if rank_a != rank_b and by_rank != final:
+                final, rule = by_rank, DecidingRule.RULE_18
+    return PairVerdict(
+        situation=situation,
+        role_colregs=role_colregs,
+        seat_a=seat_a,
+        seat_b=seat_b,
+        role_final=final,
+        deciding_rule=rule,
+        both_restricted=situation is not Situation.NONE and all(restricted),
+    )
+
+
+def _claims_restriction(nav_status: int | None, restricted_nav_statuses: frozenset[int]) -> bool:
+    return nav_status is not None and (
+        int(nav_status) in restricted_nav_statuses or rule18_rank(nav_status) >= RULE18_RANK[4]
     )

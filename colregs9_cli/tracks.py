@@ -65,6 +65,7 @@ STATIC_COLUMNS: tuple[str, ...] = (
     "callsign",
     "imo",
     "ship_type",
+    "mobile_type",
     "length_m",
     "breadth_m",
     "draught_m",

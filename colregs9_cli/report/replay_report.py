@@ -1,5 +1,5 @@
-"""The reports of ``colregs9 replay``: encounters.csv, one CSV and PNG per encounter, index.md
-and run.json.
+"""The reports of ``colregs9 replay``: pairs.csv, encounters.csv, one CSV and PNG per
+encounter (per seat), index.md and run.json.
 
 Every file is written atomically. The verdicts and time series come from
 ``colregs9_cli.replay``; this module only lays them out and draws them.
@@ -30,9 +30,10 @@ from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart
 if TYPE_CHECKING:
     from ..chart import Chart
     from ..progress import ProgressSink
-    from ..replay import EncounterOutcome, ReplayResult
+    from ..replay import EncounterOutcome, PairOutcome, ReplayResult
 
 ENCOUNTERS_NAME = "encounters.csv"
+PAIRS_NAME = "pairs.csv"
 ENCOUNTER_DIR = "encounters"
 INDEX_NAME = "index.md"
 MANIFEST_NAME = "run.json"
@@ -60,18 +61,31 @@ def _cell(value: Any) -> Any:
     return value
 
 
+def _summary_table(summaries: list[Any], columns: tuple[str, ...]) -> pd.DataFrame:
+    records = [
+        {name: _cell(value) for name, value in dataclasses.asdict(summary).items()}
+        for summary in summaries
+    ]
+    table = pd.DataFrame.from_records(records, columns=list(columns))
+    # Codes, not measurements: 0 not 0.0, empty when the vessel never sent one.
+    for name in columns:
+        if "nav_status" in name:
+            table[name] = table[name].astype("Int64")
+    return table
+
+
 def encounters_frame(outcomes: tuple[EncounterOutcome, ...]) -> pd.DataFrame:
-    """encounters.csv: one row per encounter, the columns of ``EncounterSummary`` in order."""
+    """encounters.csv: one row per triggered encounter per seat, ``EncounterSummary``'s columns."""
     from ..replay import ENCOUNTER_COLUMNS
 
-    records = [
-        {name: _cell(value) for name, value in dataclasses.asdict(o.summary).items()}
-        for o in outcomes
-    ]
-    table = pd.DataFrame.from_records(records, columns=list(ENCOUNTER_COLUMNS))
-    # A code, not a measurement: 0 not 0.0, empty when the target never sent one.
-    table["target_nav_status"] = table["target_nav_status"].astype("Int64")
-    return table
+    return _summary_table([o.summary for o in outcomes], ENCOUNTER_COLUMNS)
+
+
+def pairs_frame(pairs: tuple[PairOutcome, ...]) -> pd.DataFrame:
+    """pairs.csv: one row per triggered pair, ``PairSummary``'s columns."""
+    from ..replay import PAIR_COLUMNS
+
+    return _summary_table([p.summary for p in pairs], PAIR_COLUMNS)
 
 
 def _lowercase_booleans(frame: pd.DataFrame) -> pd.DataFrame:
@@ -88,7 +102,7 @@ def _lowercase_booleans(frame: pd.DataFrame) -> pd.DataFrame:
     return result
 
 
-def _number(value: float, decimals: int) -> str:
+def _number(value: float | None, decimals: int) -> str:
     return (
         ""
         if value is None or (isinstance(value, float) and math.isnan(value))
@@ -97,47 +111,48 @@ def _number(value: float, decimals: int) -> str:
 
 
 SUMMARY_HEADER: tuple[str, ...] = (
-    "encounter",
+    "pair",
     "situation",
-    "own role",
-    "target restricted",
-    "path",
-    "final role",
+    "ambiguous",
+    "give-way (final)",
+    "rule",
     "CPA m",
     "TCPA s",
     "min sep m",
+    "give-way acted",
 )
 
 
 def format_summary(result: ReplayResult) -> str:
-    """The short table printed to stdout: one line per encounter, then the counts."""
+    """The short table printed to stdout: one line per triggered pair, then the counts."""
     counts = result.counts
     lines = [
         f"Replay '{result.query_name}': {counts.vessels} vessels, {counts.segments} segments, "
         f"{counts.candidate_pairs} candidate pairs, {counts.encounters} encounters, "
-        f"{counts.triggered} triggered."
+        f"{counts.triggered} triggered ({counts.triggered_pairs} pairs)."
     ]
-    if not result.encounters:
+    if not result.pairs:
         lines.append(
             "No triggered encounters: no pair came within "
             f"CPA < {result.params.replay.cpa_req_m:g} m with 0 <= TCPA <= "
-            f"{result.params.replay.tcpa_act_s:g} s. encounters.csv has a header only."
+            f"{result.params.replay.tcpa_act_s:g} s. pairs.csv and encounters.csv have a "
+            "header only."
         )
         return "\n".join(lines) + "\n"
     rows = [list(SUMMARY_HEADER)]
-    for outcome in result.encounters:
-        s = outcome.summary
+    for pair in result.pairs:
+        s = pair.summary
         rows.append(
             [
-                s.encounter_id,
+                s.pair_id,
                 _cell(s.situation),
-                _cell(s.own_role_colregs),
-                _cell(s.target_estimated_restricted),
-                s.automaton_path,
-                _cell(s.own_role_final),
+                "yes" if s.situation_ambiguous else "",
+                s.give_way_vessels or "none",
+                _cell(s.deciding_rule),
                 _number(s.cpa_m, 0),
                 _number(s.tcpa_s, 0),
                 _number(s.actual_min_separation_m, 0),
+                "" if s.give_way_vessel_acted is None else _cell(s.give_way_vessel_acted),
             ]
         )
     widths = [max(len(str(row[i])) for row in rows) for i in range(len(SUMMARY_HEADER))]
@@ -149,10 +164,12 @@ def format_summary(result: ReplayResult) -> str:
 def _verdict(outcome: EncounterOutcome) -> str:
     s = outcome.summary
     rule9 = "rule 9 applied" if s.rule9_applied else "rule 9 not applied"
+    ambiguous = ", ambiguous" if s.situation_ambiguous else ""
     return (
-        f"{_cell(s.situation)}: own ship {_cell(s.own_role_colregs)} → "
-        f"{_cell(s.own_role_final)} ({rule9}, {s.automaton_path})\ntarget restricted: "
-        f"{_cell(s.target_estimated_restricted)}, CPA {s.cpa_m:.0f} m in {s.tcpa_s:.0f} s"
+        f"{_cell(s.situation)}{ambiguous}: own ship {_cell(s.own_role_colregs)} → "
+        f"{_cell(s.own_role_final)} ({rule9}, {s.automaton_path}; rule {_cell(s.deciding_rule)})"
+        f"\ntarget restricted: {_cell(s.target_estimated_restricted)}, "
+        f"CPA {s.cpa_m:.0f} m in {s.tcpa_s:.0f} s"
     )
 
 
@@ -366,35 +383,49 @@ def encounter_figure(outcome: EncounterOutcome, chart: Chart | None, ukc_m: floa
 
 
 def format_index(result: ReplayResult, plots: bool) -> str:
-    """index.md: a table of all encounters linking to their CSV and PNG."""
+    """index.md: what each file holds, then a table of the triggered encounters (per seat)."""
+    counts = result.counts
+    untriggered = counts.encounters - counts.triggered
     lines = [
         f"# Replay: {result.query_name}",
         "",
-        f"{result.counts.encounters} encounters ({result.counts.triggered} triggered) among "
-        f"{result.counts.vessels} vessels. All encounters: [{ENCOUNTERS_NAME}]({ENCOUNTERS_NAME})."
-        f" Run manifest: [{MANIFEST_NAME}]({MANIFEST_NAME}).",
+        f"{counts.vessels} vessels; {counts.encounters} encounters (a pair within range of "
+        f"each other, seen from each reported seat), {counts.triggered} of them triggered "
+        f"(CPA < {result.params.replay.cpa_req_m:g} m within 0 <= TCPA <= "
+        f"{result.params.replay.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs.",
+        "",
+        f"- [{PAIRS_NAME}]({PAIRS_NAME}): one row per triggered pair, with the pair-level "
+        "verdict (the same whichever vessel is own ship).",
+        f"- [{ENCOUNTERS_NAME}]({ENCOUNTERS_NAME}): one row per triggered encounter per seat "
+        f"({counts.triggered} rows). The {untriggered} encounters that never triggered are "
+        "counted in run.json only.",
+        f"- `{ENCOUNTER_DIR}/`: each triggered encounter's time series (CSV)"
+        + (" and figure (PNG)." if plots else "."),
+        f"- [{MANIFEST_NAME}]({MANIFEST_NAME}): inputs, parameters, rejects ledger and counts.",
         "",
     ]
-    if not result.encounters:
+    if not result.pairs:
         lines.append("No triggered encounters.")
         return "\n".join(lines) + "\n"
     lines += [
-        "| encounter | trigger (UTC) | own | target | situation | own role | target restricted "
-        "| path | final role | CPA (m) | min sep (m) | give-way acted | files |",
-        "|:--|:--|--:|--:|:--|:--|:--|:--|:--|--:|--:|:--|:--|",
+        "| encounter | trigger (UTC) | own | target | situation | ambiguous | own role "
+        "| target restricted | path | rule | final give-way | CPA (m) | min sep (m) "
+        "| give-way acted | files |",
+        "|:--|:--|--:|--:|:--|:--|:--|:--|:--|:--|:--|--:|--:|:--|:--|",
     ]
     for outcome in result.encounters:
         s = outcome.summary
         links = f"[csv]({ENCOUNTER_DIR}/{s.encounter_id}.csv)"
         if plots:
             links += f" [png]({ENCOUNTER_DIR}/{s.encounter_id}.png)"
-        acted = "" if s.give_way_vessel_acted is None else str(s.give_way_vessel_acted).lower()
+        acted = "" if s.give_way_vessel_acted is None else _cell(s.give_way_vessel_acted)
         lines.append(
             f"| {s.encounter_id} | {_cell(s.trigger_utc)} | {s.own_mmsi} | {s.target_mmsi} "
-            f"| {_cell(s.situation)} | {_cell(s.own_role_colregs)} "
-            f"| {_cell(s.target_estimated_restricted)} | {s.automaton_path} "
-            f"| {_cell(s.own_role_final)} | {_number(s.cpa_m, 0)} "
-            f"| {_number(s.actual_min_separation_m, 0)} | {acted} | {links} |"
+            f"| {_cell(s.situation)} | {'yes' if s.situation_ambiguous else ''} "
+            f"| {_cell(s.own_role_colregs)} | {_cell(s.target_estimated_restricted)} "
+            f"| {s.automaton_path} | {_cell(s.deciding_rule)} | {s.give_way_vessels or 'none'} "
+            f"| {_number(s.cpa_m, 0)} | {_number(s.actual_min_separation_m, 0)} | {acted} "
+            f"| {links} |"
         )
     return "\n".join(lines) + "\n"
 
@@ -424,8 +455,10 @@ def write_replay_reports(
         progress.advance()
     encounters_csv = out_dir / ENCOUNTERS_NAME
     write_csv(encounters_csv, _lowercase_booleans(encounters_frame(result.encounters)))
+    pairs_csv = out_dir / PAIRS_NAME
+    write_csv(pairs_csv, _lowercase_booleans(pairs_frame(result.pairs)))
     index = out_dir / INDEX_NAME
     write_text(index, format_index(result, plots))
     manifest = out_dir / MANIFEST_NAME
     write_json(manifest, result.manifest)
-    return (encounters_csv, *files, index, manifest)
+    return (pairs_csv, encounters_csv, *files, index, manifest)
