@@ -4,12 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from colregs9_cli.colregs import (
     ColregsParams,
     Kinematics,
     Role,
     Situation,
+    SituationBasis,
     classify,
     colregs_params_from_table,
     evaluate_colregs,
@@ -41,31 +44,44 @@ BOUNDARY_CASES = [
     (0.0, 6.0 + EPS, CROSSING, SO, GW, False),
     (0.0, 354.0, HEAD_ON, GW, GW, False),
     (0.0, 354.0 - EPS, CROSSING, GW, SO, False),
-    # overtaking sector 112.5°–247.5° (inclusive): own ship in the target's sector
-    (0.0, 112.5, OVERTAKING, GW, SO, True),
-    (0.0, 112.5 - EPS, CROSSING, SO, GW, False),
-    (0.0, 247.5, OVERTAKING, GW, SO, True),
-    (0.0, 247.5 + EPS, CROSSING, GW, SO, False),
+    # rule 14(c), in doubt: both on the same bow within 22.5°, and just outside
+    (20.0, 10.0, HEAD_ON, GW, GW, False),
+    (350.0, 340.0, HEAD_ON, GW, GW, False),
+    (22.5 + EPS, 10.0, CROSSING, GW, SO, False),
+    (350.0, 337.5 - EPS, CROSSING, GW, SO, False),
+    # overtaking: strictly more than 22.5° abaft the beam, (112.5°, 247.5°)
+    (0.0, 112.5 + EPS, OVERTAKING, GW, SO, True),
+    (0.0, 112.5, CROSSING, SO, GW, False),
+    (0.0, 247.5 - EPS, OVERTAKING, GW, SO, True),
+    (0.0, 247.5, CROSSING, GW, SO, False),
     (0.0, 180.0, OVERTAKING, GW, SO, True),
     # ... the target in own ship's sector
-    (112.5, 0.0, OVERTAKING, SO, GW, False),
-    (112.5 - EPS, 0.0, CROSSING, GW, SO, False),
-    (247.5, 0.0, OVERTAKING, SO, GW, False),
-    (247.5 + EPS, 0.0, CROSSING, SO, GW, False),
+    (112.5 + EPS, 0.0, OVERTAKING, SO, GW, False),
+    (112.5, 0.0, CROSSING, GW, SO, False),
+    (247.5 - EPS, 0.0, OVERTAKING, SO, GW, False),
+    (247.5, 0.0, CROSSING, SO, GW, False),
     # each astern of the other: nobody comes up from astern, so it falls through to crossing
     (150.0, 200.0, CROSSING, GW, SO, False),
     # crossing around dead ahead (0°), target on own ship's port beam side 270°
     (EPS, 270.0, CROSSING, GW, SO, False),
     (0.0, 270.0, CROSSING, GW, SO, False),
-    (360.0 - EPS, 270.0, CROSSING, SO, SO, False),  # port to port: both stand on
+    # both on the port side: the target's bearing (90° off her fore-and-aft line) decides
+    (360.0 - EPS, 270.0, CROSSING, GW, SO, False),
     # ... and own ship on the target's starboard side 90°
-    (EPS, 90.0, CROSSING, GW, GW, False),  # starboard to starboard: both give way
+    (EPS, 90.0, CROSSING, SO, GW, False),
     (0.0, 90.0, CROSSING, SO, GW, False),
     (360.0 - EPS, 90.0, CROSSING, SO, GW, False),
+    # the same-side crossings of the DMA sample (issue 13): one give-way vessel each
+    (31.4, 10.0, CROSSING, GW, SO, False),
+    (10.0, 31.4, CROSSING, SO, GW, False),
+    (100.0, 45.0, CROSSING, GW, SO, False),
+    # ... and its port-to-port pair near reciprocal courses: head-on in doubt
+    (353.9, 352.5, HEAD_ON, GW, GW, False),
     # crossing around dead astern (180°), reachable only with both astern of each other
     (180.0 - EPS, 180.0, CROSSING, GW, SO, False),
-    (180.0, 180.0, CROSSING, GW, GW, False),
     (180.0 + EPS, 180.0, CROSSING, SO, GW, False),
+    # an exact tie on one side is reciprocal courses: head-on
+    (60.0, 60.0, HEAD_ON, GW, GW, False),
     # ordinary crossings
     (45.0, 315.0, CROSSING, GW, SO, False),
     (315.0, 45.0, CROSSING, SO, GW, False),
@@ -114,14 +130,137 @@ def test_classification_is_symmetric_in_the_two_vessels() -> None:
 def test_configured_angles_move_the_boundaries() -> None:
     wide = ColregsParams(
         head_on_half_angle_deg=10.0,
+        head_on_doubt_deg=10.0,
         overtaking_sector_min_deg=100.0,
         overtaking_sector_max_deg=260.0,
     )
+    no_doubt = ColregsParams(head_on_doubt_deg=6.0)
     assert classify(8.0, 8.0, True, wide).situation[0] is HEAD_ON
-    assert classify(8.0, 8.0, True, PARAMS).situation[0] is CROSSING
+    assert classify(8.0, 3.0, True, no_doubt).situation[0] is CROSSING
+    assert classify(8.0, 3.0, True, PARAMS).situation[0] is HEAD_ON  # in doubt
     assert classify(0.0, 105.0, True, wide).situation[0] is OVERTAKING
     assert classify(0.0, 105.0, True, PARAMS).situation[0] is CROSSING
     assert classify(0.0, 255.0, True, wide).situation[0] is OVERTAKING
+
+
+def test_ambiguous_near_a_boundary_only() -> None:
+    # 1° inside the head-on sector (and the doubt region does not reach 5°/357°)
+    near_head_on = classify(5.0, 357.0, True, PARAMS)
+    assert near_head_on.situation[0] is HEAD_ON and near_head_on.ambiguous[0]
+    # 2° short of the overtaking sector
+    assert classify(0.0, 110.5, True, PARAMS).ambiguous[0]
+    assert not classify(0.0, 100.0, True, PARAMS).ambiguous[0]
+    # an ordinary crossing, far from every boundary
+    assert not classify(45.0, 315.0, True, PARAMS).ambiguous[0]
+    # a same-side crossing where the two bearings are nearly equally far from the line
+    assert classify(60.0, 62.0, True, PARAMS).ambiguous[0]
+    # the margin is a parameter; 0 turns the flag off
+    assert not classify(0.0, 110.5, True, ColregsParams(ambiguity_margin_deg=0.0)).ambiguous[0]
+    assert classify(0.0, 100.0, True, ColregsParams(ambiguity_margin_deg=15.0)).ambiguous[0]
+
+
+def test_basis_records_the_reading() -> None:
+    assert classify(45.0, 315.0, True, PARAMS).basis[0] is SituationBasis.SECTORS
+    assert classify(20.0, 10.0, True, PARAMS).basis[0] is SituationBasis.HEAD_ON_IN_DOUBT
+    assert classify(31.4, 10.0, True, PARAMS).basis[0] is SituationBasis.SAME_SIDE
+    assert classify(31.4, 10.0, False, PARAMS).basis[0] is SituationBasis.NONE
+
+
+def _scene(own_course, target_course, bearing, own_speed, target_speed, range_m=1000.0):
+    """Own ship at the origin; the target at ``bearing`` (true) and ``range_m``."""
+    bearing_rad = np.radians(bearing)
+    own = Kinematics(
+        north_m=np.zeros_like(bearing),
+        east_m=np.zeros_like(bearing),
+        cog_deg=own_course,
+        heading_deg=np.full_like(bearing, np.nan),
+        speed_mps=own_speed,
+    )
+    target = Kinematics(
+        north_m=range_m * np.cos(bearing_rad),
+        east_m=range_m * np.sin(bearing_rad),
+        cog_deg=target_course,
+        heading_deg=np.full_like(bearing, np.nan),
+        speed_mps=target_speed,
+    )
+    return own, target
+
+
+@pytest.mark.parametrize(("own_speed", "target_speed"), [(5.0, 5.0), (2.0, 7.0), (8.0, 1.0)])
+def test_grid_sweep_seats_agree_and_a_crossing_has_one_give_way_vessel(
+    own_speed: float, target_speed: float
+) -> None:
+    step = 3.0  # degrees: 120³ ≈ 1.7 M geometries per speed pair
+    grid = np.arange(0.0, 360.0, step)
+    own_course, target_course, bearing = (a.ravel() for a in np.meshgrid(grid, grid, grid))
+    own, target = _scene(
+        own_course,
+        target_course,
+        bearing,
+        np.full_like(bearing, own_speed),
+        np.full_like(bearing, target_speed),
+    )
+    forward = evaluate_colregs(own, target, PARAMS)
+    backward = evaluate_colregs(target, own, PARAMS)
+    assert (forward.situation == backward.situation).all()
+    assert (forward.own_role == backward.target_role).all()
+    assert (forward.target_role == backward.own_role).all()
+    assert (forward.ambiguous == backward.ambiguous).all()
+    give_way = (forward.own_role == GW).astype(int) + (forward.target_role == GW).astype(int)
+    situation = forward.situation
+    assert (give_way[situation == CROSSING] == 1).all()
+    assert (give_way[situation == OVERTAKING] == 1).all()
+    assert (give_way[situation == HEAD_ON] == 2).all()
+    assert (give_way[situation == NONE] == 0).all()
+    assert (forward.own_role[situation == NONE] == NO).all()
+    # every situation occurs, and closing is what separates "none" from the rest
+    assert {CROSSING, HEAD_ON, OVERTAKING, NONE} <= set(situation)
+    assert ((situation == NONE) == ~forward.closing).all()
+
+
+@given(
+    st.floats(0, 360, exclude_max=True),
+    st.floats(0, 360, exclude_max=True),
+    st.floats(0, 360, exclude_max=True),
+    st.floats(0, 360, exclude_max=True),
+    st.floats(-5e4, 5e4),
+    st.floats(-5e4, 5e4),
+)
+def test_rotating_and_moving_the_scene_changes_nothing(
+    own_course: float, target_course: float, bearing: float, turn: float, dn: float, de: float
+) -> None:
+    own, target = _scene(
+        np.array([own_course]), np.array([target_course]), np.array([bearing]), 4.0, 6.0
+    )
+    turned_own, turned_target = _scene(
+        np.array([own_course + turn]),
+        np.array([target_course + turn]),
+        np.array([bearing + turn]),
+        4.0,
+        6.0,
+    )
+    moved = Kinematics(
+        north_m=np.asarray(turned_own.north_m) + dn,
+        east_m=np.asarray(turned_own.east_m) + de,
+        cog_deg=turned_own.cog_deg,
+        heading_deg=turned_own.heading_deg,
+        speed_mps=turned_own.speed_mps,
+    )
+    moved_target = Kinematics(
+        north_m=np.asarray(turned_target.north_m) + dn,
+        east_m=np.asarray(turned_target.east_m) + de,
+        cog_deg=turned_target.cog_deg,
+        heading_deg=turned_target.heading_deg,
+        speed_mps=turned_target.speed_mps,
+    )
+    before = evaluate_colregs(own, target, PARAMS)
+    after = evaluate_colregs(moved, moved_target, PARAMS)
+    # Bearings agree to rounding; away from a boundary the situation and roles do too.
+    np.testing.assert_allclose(np.cos(np.radians(before.beta_deg - after.beta_deg)), 1.0, atol=1e-9)
+    if not before.ambiguous[0]:
+        assert before.situation[0] is after.situation[0]
+        assert before.own_role[0] is after.own_role[0]
+        assert before.target_role[0] is after.target_role[0]
 
 
 def test_relative_bearing() -> None:
@@ -209,12 +348,6 @@ def test_vectorised_over_steps() -> None:
     assert result.closing.tolist() == [True, True, False]
 
 
-def test_role_inversion() -> None:
-    assert Role.STAND_ON.inverted() is Role.GIVE_WAY
-    assert Role.GIVE_WAY.inverted() is Role.STAND_ON
-    assert Role.NONE.inverted() is Role.NONE
-
-
 def test_string_values() -> None:
     assert [s.value for s in Situation] == ["head-on", "crossing", "overtaking", "none"]
     assert [r.value for r in Role] == ["give-way", "stand-on", "none"]
@@ -229,6 +362,10 @@ def test_string_values() -> None:
         {"overtaking_sector_min_deg": 90.0},
         {"overtaking_sector_max_deg": 180.0},
         {"overtaking_sector_max_deg": 270.0},
+        {"head_on_doubt_deg": 5.0},
+        {"head_on_doubt_deg": 90.0},
+        {"ambiguity_margin_deg": -1.0},
+        {"ambiguity_margin_deg": float("inf")},
     ],
 )
 def test_parameters_out_of_range(kwargs: dict[str, float]) -> None:

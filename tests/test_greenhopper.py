@@ -45,7 +45,12 @@ EXPECTED = {
         "target_estimated_restricted": "true",
         "rule9_applied": "true",
         "own_role_final": "give-way",
+        "target_role_final": "stand-on",
+        "give_way_vessels": str(GREENHOPPER_MMSI),
+        "deciding_rule": "9",
         "automaton_path": "D1>D2>D3>D4",
+        "target_seat_automaton_path": "D1>D1",
+        "situation_ambiguous": "false",
     },
     NOT_RESTRICTED: {
         "situation": "crossing",
@@ -53,7 +58,12 @@ EXPECTED = {
         "target_estimated_restricted": "false",
         "rule9_applied": "false",
         "own_role_final": "stand-on",
+        "target_role_final": "give-way",
+        "give_way_vessels": str(TARGET_MMSI),
+        "deciding_rule": "15",
         "automaton_path": "D1>D2>D3>D1",
+        "target_seat_automaton_path": "D1>D1",
+        "situation_ambiguous": "false",
     },
 }
 VERDICT_COLUMNS = (
@@ -62,8 +72,15 @@ VERDICT_COLUMNS = (
     "target_estimated_restricted",
     "rule9_applied",
     "own_role_final",
+    "target_role_final",
+    "give_way_vessels",
+    "deciding_rule",
     "automaton_path",
+    "target_seat_automaton_path",
     "target_reports_restricted",
+    "data_covers_cpa",
+    "give_way_vessel_acted",
+    "stand_on_vessel_kept_course",
 )
 TOLERANCES = {
     "cpa_m": 1.0,
@@ -212,7 +229,7 @@ def test_the_papers_verdict(demo: DemoRun, name: str) -> None:
     assert (int(row["own_mmsi"]), int(row["target_mmsi"])) == (GREENHOPPER_MMSI, TARGET_MMSI)
     assert {k: row[k] for k in EXPECTED[name]} == EXPECTED[name]
     assert row["target_reports_restricted"] == "false"  # nav status 0: the estimate decides
-    assert row["target_dimensions_defaulted"] == "false"
+    assert row["target_dimensions_defaulted"] == ""  # the scenario's AIS gives all three
     assert float(row["target_draught_m"]) == 5.0
     assert float(row["cpa_m"]) < 150.0 and 0.0 <= float(row["tcpa_s"]) <= 180.0
 

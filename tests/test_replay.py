@@ -24,15 +24,20 @@ from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
 from colregs9_cli.chart import load_chart
 from colregs9_cli.errors import ParameterError
+from colregs9_cli.manoeuvrability import (
+    RestrictionPolicy,
+    SwingModel,
+    target_rate_of_swing_deg_per_m,
+    verdict,
+)
 from colregs9_cli.query import everything_query
 from colregs9_cli.replay import (
     ENCOUNTER_COLUMNS,
-    _acted,
-    _target_dimensions,
+    PAIR_COLUMNS,
     run_params,
     run_replay,
 )
-from colregs9_cli.replay_params import ReplayParams, TargetDimensions
+from colregs9_cli.replay_params import ReplayParams
 from colregs9_cli.simulate import simulate_scenario
 
 from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, NMEA, SCENARIOS
@@ -94,11 +99,30 @@ def _hand_cpa(
     return float(np.hypot(*p)), float(np.hypot(*(p + v * tcpa))), tcpa
 
 
-def _encounters(result) -> pd.DataFrame:
-    # "true"/"false"/"unknown" stays text even when a run has no "unknown".
-    return pd.read_csv(
-        result.out_dir / "encounters.csv", dtype={"target_estimated_restricted": str}
+TEXT_COLUMNS = {
+    name: str
+    for name in (
+        "target_estimated_restricted",
+        "own_estimated_restricted",
+        "give_way_vessels",
+        "give_way_vessel_acted",
+        "stand_on_vessel_kept_course",
+        "give_way_action",
+        "action_before_cpa_s",
+        "deciding_rule",
+        "own_dimensions_defaulted",
+        "target_dimensions_defaulted",
     )
+}
+
+
+def _encounters(result) -> pd.DataFrame:
+    # Three-valued and list columns stay text even when a run has only one kind of value.
+    return pd.read_csv(result.out_dir / "encounters.csv", dtype=TEXT_COLUMNS)
+
+
+def _pairs(result) -> pd.DataFrame:
+    return pd.read_csv(result.out_dir / "pairs.csv", dtype=str, keep_default_na=False)
 
 
 def test_national_sample_finds_the_close_quarters_pairs(national) -> None:
@@ -122,15 +146,104 @@ def test_national_sample_finds_the_close_quarters_pairs(national) -> None:
 def test_national_sample_has_no_chart_so_manoeuvrability_is_unknown(national) -> None:
     table = _encounters(national)
     assert (table["target_estimated_restricted"] == "unknown").all()
-    # Unknown is ¬d3: rule 9 can only come from a reported restricted status (d2).
-    expected = (table["own_role_colregs"] == "stand-on") & table["target_reports_restricted"]
-    assert (table["rule9_applied"] == expected).all()
-    stand_on = table[table["own_role_colregs"] == "stand-on"]
-    assert set(stand_on["automaton_path"]) <= {"D1>D2>D3>D1", "D1>D2>D4"}
-    assert (table.loc[table["own_role_colregs"] != "stand-on", "automaton_path"] == "D1>D1").all()
-    assert json.loads((national.out_dir / "run.json").read_text())["verdicts"][
-        "target_estimated_restricted"
-    ] == {"true": 0, "false": 0, "unknown": NATIONAL_TRIGGERED}
+    assert (table["own_estimated_restricted"] == "unknown").all()
+    # Unknown is ¬d3: G_d reaches D4 only from a reported restricted status (d2).
+    gives_way = table["target_role_colregs"] == "give-way"
+    assert set(table.loc[gives_way, "automaton_path"]) <= {"D1>D2>D3>D1", "D1>D2>D4"}
+    assert (table.loc[~gives_way, "automaton_path"] == "D1>D1").all()
+    assert not table["rule9_applied"].any()
+    verdicts = json.loads((national.out_dir / "run.json").read_text())["verdicts"]
+    assert verdicts["estimated_restricted"] == {"unknown": NATIONAL_TRIGGERED}
+    assert verdicts["pairs"] == NATIONAL_TRIGGERED // 2
+
+
+def _seat_pairs(table: pd.DataFrame) -> pd.DataFrame:
+    """Each pair's two seats side by side (suffix _other for the mirrored seat)."""
+    mirrored = table.merge(
+        table,
+        left_on=["pair_id", "own_mmsi", "target_mmsi"],
+        right_on=["pair_id", "target_mmsi", "own_mmsi"],
+        suffixes=("", "_other"),
+    )
+    return mirrored[mirrored["own_mmsi"] < mirrored["target_mmsi"]]
+
+
+PAIR_LEVEL_COLUMNS = (
+    "situation",
+    "situation_ambiguous",
+    "situation_basis",
+    "give_way_vessels",
+    "deciding_rule",
+    "rule9_applied",
+    "both_restricted",
+    "data_covers_cpa",
+    "actual_min_separation_m",
+    "give_way_vessel_acted",
+    "give_way_action",
+    "stand_on_vessel_kept_course",
+    "trigger_utc",
+)
+
+
+def assert_seats_agree(table: pd.DataFrame) -> int:
+    """Every pair seen from both seats has one situation and one set of give-way vessels,
+    and a crossing has exactly one give-way vessel. Returns the number of pairs checked."""
+    pairs = _seat_pairs(table)
+    for column in PAIR_LEVEL_COLUMNS:
+        left, right = pairs[column], pairs[f"{column}_other"]
+        assert ((left == right) | (left.isna() & right.isna())).all(), column
+    assert (pairs["own_role_final"] == pairs["target_role_final_other"]).all()
+    assert (pairs["own_role_colregs"] == pairs["target_role_colregs_other"]).all()
+    assert (pairs["automaton_path"] == pairs["target_seat_automaton_path_other"]).all()
+    final_give_way = pairs["give_way_vessels"].str.split(";").str.len()
+    assert (final_give_way[pairs["situation"] == "crossing"] == 1).all()
+    assert (final_give_way[pairs["situation"] == "overtaking"] == 1).all()
+    for row in pairs.itertuples():
+        named = set(str(row.give_way_vessels).split(";"))
+        by_role = {
+            str(m)
+            for m, role in (
+                (row.own_mmsi, row.own_role_final),
+                (row.target_mmsi, row.target_role_final),
+            )
+            if role == "give-way"
+        }
+        assert named == by_role
+    return len(pairs)
+
+
+def test_national_sample_seats_agree(national) -> None:
+    table = _encounters(national)
+    assert assert_seats_agree(table) == NATIONAL_TRIGGERED // 2
+    pairs = _pairs(national)
+    assert list(pairs.columns) == list(PAIR_COLUMNS)
+    assert len(pairs) == NATIONAL_TRIGGERED // 2
+    assert set(pairs["pair_id"]) == set(table["pair_id"])
+    # The issue's two contradictory pairs: now one head-on in doubt and one crossing.
+    by_pair = pairs.set_index(["mmsi_a", "mmsi_b"])
+    assert by_pair.loc[("219230000", "219622000"), "situation"] == "head-on"
+    assert by_pair.loc[("219230000", "219622000"), "situation_basis"] == "head-on in doubt"
+    first = by_pair.loc[("211440340", "211457700")]
+    assert (first["situation"] == "crossing").all()
+    assert (first["give_way_vessels"].str.count(";") == 0).all()
+
+
+def test_no_audit_fact_is_judged_on_data_that_stops(national) -> None:
+    table = _encounters(national)
+    stops = ~table["data_covers_cpa"]
+    assert stops.any() and (~stops).any()
+    assert table.loc[stops, "actual_min_separation_m"].isna().all()
+    assert table.loc[stops, "actual_min_separation_utc"].isna().all()
+    for column in ("give_way_vessel_acted", "stand_on_vessel_kept_course"):
+        judged = table.loc[stops, column].dropna()
+        assert (judged == "insufficient-data").all(), column
+    assert table.loc[~stops, "actual_min_separation_m"].notna().all()
+    assert set(table["give_way_vessel_acted"].dropna()) <= {"true", "false", "insufficient-data"}
+    for outcome in national.encounters:
+        summary = outcome.summary
+        if not summary.data_covers_cpa:
+            assert set(summary.give_way_action.split(";")) == {"insufficient-data"}
+            assert summary.action_before_cpa_s.strip(";") == ""
 
 
 def test_national_cpa_by_hand(national, raw_reports: pd.DataFrame) -> None:
@@ -181,10 +294,14 @@ def test_national_time_series_runs_from_the_trigger_until_the_pass(national) -> 
         assert series["timestamp"].iloc[0] == summary.trigger_utc
         assert (series["tcpa_s"] >= 0.0).all()
         assert (np.diff(series["step"]) == 1).all()
-        assert series["timestamp"].iloc[-1] <= summary.end_utc
+        horizon = pd.Timedelta(seconds=summary.tcpa_s + national.params.replay.tcpa_act_s + 1)
+        assert series["timestamp"].iloc[-1] <= summary.trigger_utc + horizon
         assert series["automaton_path"].iloc[0] == summary.automaton_path
-        assert series["situation"].iloc[0] == summary.situation.value
-        assert summary.actual_min_separation_m <= series["range_m"].min() + 1e-9
+        # the situation is held from the trigger; the instantaneous one may change
+        assert (series["situation"] == summary.situation.value).all()
+        assert series["situation_now"].iloc[0] == summary.situation.value
+        if summary.data_covers_cpa:
+            assert summary.actual_min_separation_m <= series["range_m"].min() + 1e-9
 
 
 def test_national_ledger_counts_track_drops(national, raw_reports: pd.DataFrame) -> None:
@@ -243,37 +360,6 @@ def test_a_stricter_trigger_finds_fewer_encounters(tmp_path: Path) -> None:
     assert (table["cpa_m"] < 20.0).all()
 
 
-@pytest.mark.parametrize(
-    ("course_deg", "speed_kn", "acted"),
-    [
-        ([10.0, 12.0, 24.9], [10.0, 10.0, 10.0], False),  # 14.9° < 15°
-        ([10.0, 12.0, 25.0], [10.0, 10.0, 10.0], True),  # exactly 15°
-        ([355.0, 5.0, 9.0], [10.0, 10.0, 10.0], False),  # 14° across north
-        ([350.0, 0.0, 5.0], [10.0, 10.0, 10.0], True),  # 15° across north
-        ([90.0, 90.0, 90.0], [10.0, 8.0, 7.6], False),  # 24 % slower
-        ([90.0, 90.0, 90.0], [10.0, 8.0, 7.5], True),  # 25 % slower
-        ([90.0, 90.0, 90.0], [8.0, 9.0, 10.0], True),  # 25 % faster
-    ],
-)
-def test_give_way_vessel_acted_thresholds(
-    course_deg: list[float], speed_kn: list[float], acted: bool
-) -> None:
-    assert _acted(np.array(course_deg), np.array(speed_kn), ReplayParams()) is acted
-
-
-def test_missing_dimensions_take_the_documented_defaults() -> None:
-    vessels = pd.DataFrame(
-        {"length_m": [120.0, np.nan], "breadth_m": [20.0, 8.0], "draught_m": [7.5, np.nan]},
-        index=pd.Index([1, 2], name="mmsi"),
-    )
-    defaults = ReplayParams().target_defaults
-    assert _target_dimensions(vessels, 1, defaults) == (120.0, 20.0, 7.5, False)
-    assert _target_dimensions(vessels, 2, defaults) == (50.1, 8.0, 3.2, True)
-    longer = ReplayParams(default_length_m=80.0, default_draught_m=4.5).target_defaults
-    assert longer == TargetDimensions(80.0, 9.2, 4.5)
-    assert _target_dimensions(vessels, 2, longer) == (80.0, 8.0, 4.5, True)
-
-
 GREENHOPPER, TARGET = 219999001, 219999002
 
 
@@ -330,7 +416,7 @@ def test_restricted_crossing_goes_through_d3_to_d4(restricted) -> None:
         9.0,
         5.0,
     )
-    assert not row["target_dimensions_defaulted"]
+    assert pd.isna(row["target_dimensions_defaulted"])  # all three from AIS
     assert not row["target_reports_restricted"]  # nav status 0: d3, not d2, decides
     assert row["give_way_vessel"] == "own"
     assert row["cpa_m"] < 150.0 and 0.0 <= row["tcpa_s"] <= 180.0
@@ -369,7 +455,154 @@ def test_estimates_are_fresh_wherever_g_d_reaches_d3(restricted, not_restricted)
     for result in (restricted, not_restricted):
         series = _seat(result, GREENHOPPER).series
         reaches_d3 = series["automaton_path"].str.contains("D3")
-        age_s = (series["timestamp"] - series["restricted_assessed_utc"]).dt.total_seconds()
+        age_s = (series["timestamp"] - series["target_assessed_utc"]).dt.total_seconds()
         assert reaches_d3.any()
         assert (age_s[reaches_d3] < result.params.replay.reassess_every_s).all()
         assert (age_s >= 0).all()
+
+
+# --- every path of G_d through a replay, from scenarios written here ---------------------
+
+HEAD_ON_SCENARIO = """
+name = "{name}"
+description = "Head-on: the Greenhopper northbound, the 5 m target southbound."
+start_utc = 2024-09-09T12:00:00Z
+duration_s = {duration_s}
+step_s = 1.0
+ais_interval_s = 2.0
+
+[[vessel]]
+role = "own"
+mmsi = 219999001
+name = "GREENHOPPER"
+callsign = "OZGH1"
+ship_type = "Passenger"
+nav_status = 0
+length_m = 11.0
+breadth_m = 4.0
+draught_m = 0.5
+route = [[57.0560, 9.9560], [57.0640, 9.9640]]
+speed_kn = 2.0
+
+[[vessel]]
+role = "target"
+mmsi = 219999002
+name = "MODEL TARGET"
+callsign = "OZMT2"
+ship_type = "Cargo"
+nav_status = {target_status}
+length_m = 50.0
+breadth_m = 9.0
+draught_m = 5.0
+route = [[57.0680, 9.9682], [57.0560, 9.9562]]
+speed_kn = 7.0
+"""
+
+
+def _replay_scenario(work: Path, text: str, overrides=None):
+    scenario = work / "scenario.toml"
+    # a copied scenario names its chart relative to fixtures/scenarios/
+    text = text.replace('chart = "../charts/', f'chart = "{MODELLED_CHART.parent.as_posix()}/')
+    scenario.write_text(text, encoding="utf-8")
+    simulated = simulate_scenario(scenario, out=work / "ais.csv")
+    return run_replay(
+        [simulated.out_path],
+        chart_paths=[MODELLED_CHART],
+        query_path=GREENHOPPER_QUERY,
+        out_dir=work / "replay",
+        plots=False,
+        overrides=overrides,
+    )
+
+
+def _head_on(tmp_path: Path, target_status: int = 0, duration_s: float = 420.0):
+    text = HEAD_ON_SCENARIO.format(
+        name="head_on", duration_s=duration_s, target_status=target_status
+    )
+    return _encounters(_replay_scenario(tmp_path, text)).set_index("own_mmsi")
+
+
+def test_head_on_with_a_restricted_target_she_stands_on(tmp_path: Path) -> None:
+    table = _head_on(tmp_path)
+    assert_seats_agree(table.reset_index())
+    own = table.loc[GREENHOPPER]
+    assert (own["situation"], own["own_role_colregs"], own["target_role_colregs"]) == (
+        "head-on",
+        "give-way",
+        "give-way",
+    )
+    # d1 (the target must give way, as in every head-on) → D2 → D3 (estimated) → D4
+    assert own["automaton_path"] == "D1>D2>D3>D4"
+    assert own["target_seat_automaton_path"] == "D1>D2>D3>D1"  # the Greenhopper has room
+    assert (own["own_role_final"], own["target_role_final"]) == ("give-way", "stand-on")
+    assert own["deciding_rule"] == "9" and bool(own["rule9_applied"])
+    assert own["give_way_vessels"] == str(GREENHOPPER)
+    assert bool(own["data_covers_cpa"])
+
+
+def test_head_on_with_a_target_reporting_status_3_goes_d1_d2_d4(tmp_path: Path) -> None:
+    own = _head_on(tmp_path, target_status=3).loc[GREENHOPPER]
+    assert own["automaton_path"] == "D1>D2>D4"
+    assert bool(own["target_reports_restricted"])
+    assert (own["own_role_final"], own["target_role_final"]) == ("give-way", "stand-on")
+    assert own["deciding_rule"] == "18" and not bool(own["rule9_applied"])
+
+
+def test_crossing_with_a_target_reporting_status_3_goes_d1_d2_d4(
+    tmp_path: Path,
+) -> None:
+    text = (SCENARIOS / "greenhopper_not_restricted.toml").read_text(encoding="utf-8")
+    # the target is the second vessel: give her status 3 (restricted manoeuvrability)
+    head, target = text.split('role = "target"')
+    target = target.replace("nav_status = 0", "nav_status = 3", 1)
+    table = _encounters(_replay_scenario(tmp_path, head + 'role = "target"' + target))
+    assert_seats_agree(table)
+    own = table.set_index("own_mmsi").loc[GREENHOPPER]
+    assert own["automaton_path"] == "D1>D2>D4"
+    assert (own["own_role_final"], own["target_role_final"]) == ("give-way", "stand-on")
+    assert own["deciding_rule"] == "18"
+
+
+def test_tracks_that_stop_before_cpa_give_insufficient_data(tmp_path: Path) -> None:
+    table = _head_on(tmp_path, duration_s=200.0)
+    assert not table["data_covers_cpa"].any()
+    assert table["actual_min_separation_m"].isna().all()
+    assert (table["give_way_vessel_acted"] == "insufficient-data").all()
+    assert (table["give_way_action"] == "insufficient-data").all()
+    # the verdict itself stands: it is made at the trigger
+    assert (table["give_way_vessels"] == str(GREENHOPPER)).all()
+
+
+@pytest.mark.parametrize(
+    "manoeuvrability",
+    [
+        {"policy": RestrictionPolicy.BOTH_SIDES},
+        {"policy": RestrictionPolicy.STARBOARD},
+        {"swing_model": SwingModel.NEAREST_LENGTH},
+        {"swing_model": SwingModel.LOWER_BOUND},
+    ],
+)
+def test_policies_and_swing_models_through_a_replay_on_a_chart(
+    tmp_path: Path, manoeuvrability: dict
+) -> None:
+    text = (SCENARIOS / "greenhopper_restricted.toml").read_text(encoding="utf-8")
+    result = _replay_scenario(tmp_path, text, overrides={"manoeuvrability": manoeuvrability})
+    params = result.params.manoeuvrability
+    for name, value in manoeuvrability.items():
+        assert getattr(params, name) is value
+    own = _seat(result, GREENHOPPER)
+    assessment = own.assessment
+    assert assessment.policy is params.policy
+    # δ' = α·δ_swing of the chosen model for the 50 m target
+    assert assessment.rate_of_swing_deg_per_m == pytest.approx(
+        params.alpha * target_rate_of_swing_deg_per_m(50.0, params)
+    )
+    # the replay's verdict is the policy applied to the flags of the ellipses it drew
+    assert own.summary.target_estimated_restricted is verdict(
+        params.policy, assessment.arc, assessment.restricted, assessment.covered, True
+    )
+    expected_path = (
+        "D1>D2>D3>D4" if own.summary.target_estimated_restricted.value == "true" else "D1>D2>D3>D1"
+    )
+    assert own.summary.automaton_path == expected_path
+    assert_seats_agree(_encounters(result))

@@ -10,17 +10,19 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from colregs9_cli.colregs import Role
+from colregs9_cli.colregs import Role, Situation
 from colregs9_cli.rule9 import (
     INITIAL_STATE,
     MARKED_STATES,
     TRANSITIONS,
+    DecidingRule,
     Event,
     Finding,
     State,
     UndefinedTransitionError,
     accepts,
     assess_rule9,
+    decide_pair,
     path_text,
     run,
     step,
@@ -143,41 +145,38 @@ def test_path_text() -> None:
     assert path_text(run([Event.D1, Event.NOT_D2, Event.NOT_D3])) == "D1>D2>D3>D1"
 
 
-# (own role, nav status, estimator, path, rule 9 applied, final own role, d2, d3)
+# (target's role under rules 13–15, her nav status, estimator, path, D4 reached, d2, d3)
 ASSESSMENTS = [
-    (Role.GIVE_WAY, 3, "true", "D1>D1", False, Role.GIVE_WAY, "not-evaluated", "not-evaluated"),
-    (Role.NONE, 0, "unknown", "D1>D1", False, Role.NONE, "not-evaluated", "not-evaluated"),
-    (Role.STAND_ON, 3, "false", "D1>D2>D4", True, Role.GIVE_WAY, "true", "not-evaluated"),
-    (Role.STAND_ON, 4, "unknown", "D1>D2>D4", True, Role.GIVE_WAY, "true", "not-evaluated"),
-    (Role.STAND_ON, 0, "true", "D1>D2>D3>D4", True, Role.GIVE_WAY, "false", "true"),
-    (Role.STAND_ON, 0, "false", "D1>D2>D3>D1", False, Role.STAND_ON, "false", "false"),
-    (Role.STAND_ON, 0, "unknown", "D1>D2>D3>D1", False, Role.STAND_ON, "false", "unknown"),
-    (Role.STAND_ON, None, "true", "D1>D2>D3>D4", True, Role.GIVE_WAY, "unknown", "true"),
-    (Role.STAND_ON, None, "unknown", "D1>D2>D3>D1", False, Role.STAND_ON, "unknown", "unknown"),
-    (Role.STAND_ON, 7, "false", "D1>D2>D3>D1", False, Role.STAND_ON, "false", "false"),
+    (Role.STAND_ON, 3, "true", "D1>D1", False, "not-evaluated", "not-evaluated"),
+    (Role.NONE, 0, "unknown", "D1>D1", False, "not-evaluated", "not-evaluated"),
+    (Role.GIVE_WAY, 3, "false", "D1>D2>D4", True, "true", "not-evaluated"),
+    (Role.GIVE_WAY, 4, "unknown", "D1>D2>D4", True, "true", "not-evaluated"),
+    (Role.GIVE_WAY, 0, "true", "D1>D2>D3>D4", True, "false", "true"),
+    (Role.GIVE_WAY, 0, "false", "D1>D2>D3>D1", False, "false", "false"),
+    (Role.GIVE_WAY, 0, "unknown", "D1>D2>D3>D1", False, "false", "unknown"),
+    (Role.GIVE_WAY, None, "true", "D1>D2>D3>D4", True, "unknown", "true"),
+    (Role.GIVE_WAY, None, "unknown", "D1>D2>D3>D1", False, "unknown", "unknown"),
+    (Role.GIVE_WAY, 7, "false", "D1>D2>D3>D1", False, "false", "false"),
 ]
 
 
 @pytest.mark.parametrize(
-    ("own_role", "nav_status", "estimate", "path", "applied", "final_role", "d2", "d3"),
-    ASSESSMENTS,
+    ("target_role", "nav_status", "estimate", "path", "applied", "d2", "d3"), ASSESSMENTS
 )
 def test_assessments(
-    own_role: Role,
+    target_role: Role,
     nav_status: int | None,
     estimate: str,
     path: str,
     applied: bool,
-    final_role: Role,
     d2: str,
     d3: str,
 ) -> None:
-    result = assess_rule9(own_role, nav_status, estimate)
+    result = assess_rule9(target_role, nav_status, estimate)
     assert result.path_text == path
     assert result.rule9_applied is applied
-    assert result.own_role_colregs is own_role
-    assert result.own_role_final is final_role
-    assert result.d1 is (own_role is Role.STAND_ON)
+    assert result.target_role_colregs is target_role
+    assert result.d1 is (target_role is Role.GIVE_WAY)
     assert result.d2 == Finding(d2)
     assert result.d3 == Finding(d3)
     assert run(result.events) == result.path
@@ -185,7 +184,7 @@ def test_assessments(
 
 
 def test_unknown_estimate_is_recorded_as_unknown_never_as_not_restricted() -> None:
-    result = assess_rule9(Role.STAND_ON, 0, "unknown")
+    result = assess_rule9(Role.GIVE_WAY, 0, "unknown")
     assert result.events[-1] is Event.NOT_D3
     assert result.d3 is Finding.UNKNOWN
     assert result.d3 != Finding.FALSE
@@ -193,28 +192,129 @@ def test_unknown_estimate_is_recorded_as_unknown_never_as_not_restricted() -> No
 
 def test_restricted_status_set_is_configurable() -> None:
     fishing = frozenset({7})
-    assert assess_rule9(Role.STAND_ON, 7, "false", fishing).path_text == "D1>D2>D4"
-    assert assess_rule9(Role.STAND_ON, 3, "false", fishing).path_text == "D1>D2>D3>D1"
+    assert assess_rule9(Role.GIVE_WAY, 7, "false", fishing).path_text == "D1>D2>D4"
+    assert assess_rule9(Role.GIVE_WAY, 3, "false", fishing).path_text == "D1>D2>D3>D1"
 
 
-@pytest.mark.parametrize("own_role", list(Role))
+@pytest.mark.parametrize("target_role", list(Role))
 @pytest.mark.parametrize("nav_status", [None, *range(16)])
 @pytest.mark.parametrize("estimate", ["true", "false", "unknown"])
 def test_every_assessment_ends_in_a_marked_state_after_a_transition(
-    own_role: Role, nav_status: int | None, estimate: str
+    target_role: Role, nav_status: int | None, estimate: str
 ) -> None:
-    result = assess_rule9(own_role, nav_status, estimate)
+    result = assess_rule9(target_role, nav_status, estimate)
     assert result.path[0] is D1
     assert len(result.path) >= 2
     assert result.final_state in MARKED_STATES
     assert all(state not in MARKED_STATES for state in result.path[1:-1])
-    # D4 inverts the role; every other end keeps it.
-    expected = own_role.inverted() if result.rule9_applied else own_role
-    assert result.own_role_final is expected
+    # D4 only for a target that had to give way (d1), as in the paper
     if result.rule9_applied:
-        assert (own_role, result.own_role_final) == (Role.STAND_ON, Role.GIVE_WAY)
+        assert target_role is Role.GIVE_WAY
 
 
 def test_estimator_value_must_be_a_restriction() -> None:
     with pytest.raises(ValueError, match="'maybe'"):
-        assess_rule9(Role.STAND_ON, 0, "maybe")
+        assess_rule9(Role.GIVE_WAY, 0, "maybe")
+
+
+# --- the pair's final roles --------------------------------------------------------------
+
+HO, CR, OT, NS = Situation.HEAD_ON, Situation.CROSSING, Situation.OVERTAKING, Situation.NONE
+GW, SO, NO = Role.GIVE_WAY, Role.STAND_ON, Role.NONE
+R9, R13, R14, R15, R18 = (
+    DecidingRule.RULE_9,
+    DecidingRule.RULE_13,
+    DecidingRule.RULE_14,
+    DecidingRule.RULE_15,
+    DecidingRule.RULE_18,
+)
+
+# (situation, roles a/b, nav a/b, estimate a/b, final a/b, rule, both restricted)
+PAIR_CASES = [
+    # the paper's crossing: b gives way, is estimated restricted → she stands on (rule 9)
+    (CR, (SO, GW), (0, 0), ("false", "true"), (GW, SO), R9, False),
+    (CR, (SO, GW), (0, 0), ("false", "false"), (SO, GW), R15, False),
+    # the same from a restricted stand-on vessel: nothing to invert
+    (CR, (SO, GW), (0, 0), ("true", "false"), (SO, GW), R15, False),
+    # b reports restricted manoeuvrability (D1>D2>D4 in a's seat): rule 18
+    (CR, (SO, GW), (0, 3), ("false", "false"), (GW, SO), R18, False),
+    # head-on, b restricted: she is not expected to give way (rule 18 / rule 9)
+    (HO, (GW, GW), (0, 3), ("unknown", "unknown"), (GW, SO), R18, False),
+    (HO, (GW, GW), (0, 0), ("unknown", "true"), (GW, SO), R9, False),
+    # head-on, both restricted: rule 14 stays, flagged
+    (HO, (GW, GW), (3, 0), ("false", "true"), (GW, GW), R14, True),
+    # port to port, each stand-on... the crossing b gives way, reports 3; a reports 3 too
+    (CR, (SO, GW), (3, 3), ("false", "false"), (SO, GW), R15, True),
+    # a estimated restricted as give-way, b reports 3 as stand-on: both restricted
+    (CR, (GW, SO), (0, 3), ("true", "false"), (GW, SO), R15, True),
+    # overtaking: rule 13 whatever the status or estimate
+    (OT, (GW, SO), (3, 0), ("true", "false"), (GW, SO), R13, False),
+    (OT, (SO, GW), (0, 0), ("false", "true"), (SO, GW), R13, False),
+    # rule 18 where AIS says so: a fishing vessel gives way to nobody but NUC/RAM/CBD
+    (CR, (GW, SO), (7, 0), ("false", "false"), (SO, GW), R18, False),
+    (CR, (SO, GW), (7, 0), ("false", "false"), (SO, GW), R15, False),
+    (CR, (GW, SO), (8, 7), ("false", "false"), (GW, SO), R15, False),  # sailing < fishing
+    (CR, (SO, GW), (8, 7), ("false", "false"), (GW, SO), R18, False),
+    (HO, (GW, GW), (0, 8), ("false", "false"), (GW, SO), R18, False),
+    (HO, (GW, GW), (None, None), ("unknown", "unknown"), (GW, GW), R14, False),
+    # not under command (2) is not in the d2 set by default, yet rule 18 applies
+    (CR, (GW, SO), (2, 0), ("false", "false"), (SO, GW), R18, False),
+    (NS, (NO, NO), (3, 0), ("true", "true"), (NO, NO), DecidingRule.NONE, False),
+]
+
+
+@pytest.mark.parametrize(
+    ("situation", "roles", "nav", "estimates", "final", "rule", "both"), PAIR_CASES
+)
+def test_pair_final_roles_are_the_same_from_both_seats(
+    situation: Situation,
+    roles: tuple[Role, Role],
+    nav: tuple[int | None, int | None],
+    estimates: tuple[str, str],
+    final: tuple[Role, Role],
+    rule: DecidingRule,
+    both: bool,
+) -> None:
+    verdict = decide_pair(situation, roles, nav, estimates)
+    assert verdict.role_final == final
+    assert verdict.deciding_rule is rule
+    assert verdict.both_restricted is both
+    mirrored = decide_pair(situation, roles[::-1], nav[::-1], estimates[::-1])
+    assert mirrored == verdict.swapped()
+    assert mirrored.role_final == final[::-1]
+
+
+ROLE_PAIRS = {HO: (GW, GW), CR: (SO, GW), OT: (GW, SO), NS: (NO, NO)}
+
+
+@given(
+    st.sampled_from([HO, CR, OT, NS]),
+    st.booleans(),
+    st.sampled_from([None, *range(16)]),
+    st.sampled_from([None, *range(16)]),
+    st.sampled_from(["true", "false", "unknown"]),
+    st.sampled_from(["true", "false", "unknown"]),
+)
+def test_every_pair_verdict_is_consistent(
+    situation: Situation,
+    swap: bool,
+    nav_a: int | None,
+    nav_b: int | None,
+    estimate_a: str,
+    estimate_b: str,
+) -> None:
+    roles = ROLE_PAIRS[situation][::-1] if swap else ROLE_PAIRS[situation]
+    verdict = decide_pair(situation, roles, (nav_a, nav_b), (estimate_a, estimate_b))
+    give_way = verdict.role_final.count(GW)
+    if situation is NS:
+        assert verdict.role_final == (NO, NO)
+    elif situation is HO:
+        assert give_way in (1, 2)
+        assert give_way == 2 or verdict.deciding_rule in (R9, R18)
+    else:
+        assert give_way == 1  # a crossing or overtaking never ends with both or neither
+    if situation is OT:
+        assert verdict.role_final == roles and verdict.deciding_rule is R13
+    assert verdict.rule9_applied is (verdict.deciding_rule is R9)
+    mirrored = decide_pair(situation, roles[::-1], (nav_b, nav_a), (estimate_b, estimate_a))
+    assert mirrored == verdict.swapped()
