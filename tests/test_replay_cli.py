@@ -60,9 +60,11 @@ def test_replay_prints_a_summary_and_writes_the_reports(tmp_path: Path) -> None:
     result = _invoke(str(NMEA), "--no-plots", "--quiet", "--out", str(tmp_path))
     assert result.exit_code == 0, result.output
     table = pd.read_csv(tmp_path / "encounters.csv")
-    # One summary line per encounter, each naming its id, between the counts and the footer.
-    for encounter_id in table["encounter_id"]:
-        assert encounter_id in result.output
+    # One summary line per triggered pair, each naming its id, between counts and footer.
+    pairs = pd.read_csv(tmp_path / "pairs.csv")
+    for pair_id in pairs["pair_id"]:
+        assert pair_id in result.output
+    assert len(result.output.splitlines()) == len(pairs) + 3
     assert "26 triggered" in result.output
     assert f"Reports in {tmp_path}" in result.output
     assert not list((tmp_path / "encounters").glob("*.png"))

@@ -110,7 +110,8 @@ def test_time_series_columns_and_values(run) -> None:
         ),
         rtol=1e-9,
     )
-    assert series["restricted_assessed_utc"].iloc[0] == series["timestamp"].iloc[0]
+    assert series["target_assessed_utc"].iloc[0] == series["timestamp"].iloc[0]
+    assert series["own_assessed_utc"].iloc[0] == series["timestamp"].iloc[0]
 
 
 def test_index_links_resolve(run) -> None:
@@ -120,7 +121,7 @@ def test_index_links_resolve(run) -> None:
     encounter_id = outcome.summary.encounter_id
     assert f"encounters/{encounter_id}.csv" in links
     assert f"encounters/{encounter_id}.png" in links
-    assert "encounters.csv" in links and "run.json" in links
+    assert "encounters.csv" in links and "run.json" in links and "pairs.csv" in links
     for link in links:
         assert (run.out_dir / link).is_file(), link
 
@@ -130,7 +131,7 @@ def test_manifest(run) -> None:
     assert {"version", "parameters", "inputs", "ledger", "counts", "frame"} <= set(manifest)
     parameters = manifest["parameters"]
     assert {"replay", "colregs", "manoeuvrability", "own_mmsi"} <= set(parameters)
-    assert parameters["replay"]["default_length_m"] == 50.1
+    assert parameters["replay"]["default_length_m"] is None  # by ship type, vessel_defaults
     assert parameters["replay"]["reassess_every_s"] == 10.0
     assert parameters["replay"]["tcpa_act_s"] == 180.0
     assert parameters["replay"]["cpa_req_m"] == 150.0
@@ -150,7 +151,9 @@ def test_manifest(run) -> None:
         "candidate_pairs",
         "encounters",
         "triggered",
+        "triggered_pairs",
     }
+    assert manifest["verdicts"]["pairs"] == 1
 
 
 def test_png_smoke_render(run) -> None:
