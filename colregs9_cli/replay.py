@@ -11,9 +11,10 @@ dropped as same-second duplicates or speed jumps go into the rejects ledger) →
 - **G_d** (``rule9.py``) runs in both seats at every step, and ``decide_pair`` combines them
   with rules 13 and 18 into the pair's final roles. The verdict is the one at the trigger.
 - **Manoeuvrability** (event d3) is estimated for both vessels at the trigger (it is the
-  verdict and the figure), and later only for a vessel whose G_d reaches D3 there (she gives
-  way and does not report a restricted status), at most every ``reassess_every_s``;
-  otherwise the last estimate is carried forward. No chart, or a vessel outside the chart's
+  verdict and the figure), and later for each vessel that does not report a restricted
+  status, at most every ``reassess_every_s``; otherwise the last estimate is carried
+  forward. The give-way vessel's estimate is G_d's d3; the stand-on vessel's tells whether
+  both are restricted (``rule9.decide_pair``). No chart, or a vessel outside the chart's
   coverage, gives ``unknown``: ¬d3 for the automaton, recorded as ``unknown``.
 - **Dimensions** a vessel does not report take the defaults of ``vessel_defaults.py`` (by
   Class A/B and ship type); a verdict in which the estimator's answer for such a vessel
@@ -545,11 +546,10 @@ def _pair_steps(
     trigger: list[ManoeuvrabilityAssessment] = []
     for row in range(rows):
         for vessel in (0, 1):
-            # G_d reaches D3 about this vessel when she gives way and reports no restriction.
-            reaches_d3 = roles[vessel] is Role.GIVE_WAY and (
-                nav_status_finding(nav[vessel][row], statuses) is not Finding.TRUE
-            )
-            assessment = estimators[vessel].at(states[vessel], row, needed=reaches_d3)
+            # Every vessel's estimate counts (decide_pair): the give-way vessel's for G_d,
+            # the stand-on vessel's for "both restricted". A reported status makes it moot.
+            needed = nav_status_finding(nav[vessel][row], statuses) is not Finding.TRUE
+            assessment = estimators[vessel].at(states[vessel], row, needed=needed)
             if row == 0:
                 trigger.append(assessment)
             estimates[vessel].append(assessment.restriction)
@@ -569,10 +569,23 @@ def _pair_steps(
     )
 
 
-def _rests_on_defaults(verdict: PairVerdict, dimensions: tuple[VesselDimensions, ...]) -> bool:
-    """True when an estimate for a vessel with defaulted dimensions entered G_d (d3)."""
-    about = ((verdict.seat_b, dimensions[0]), (verdict.seat_a, dimensions[1]))
-    return any(seat.d3 is not Finding.NOT_EVALUATED and dims.defaulted for seat, dims in about)
+def _rests_on_defaults(
+    verdict: PairVerdict,
+    dimensions: tuple[VesselDimensions, ...],
+    estimates: tuple[Restriction, Restriction],
+) -> bool:
+    """True when the estimator's answer for a vessel with defaulted dimensions decided: as
+    G_d's d3 about her (the give-way vessel), or as her "restricted" that made both
+    restricted. "Unknown" (no chart) rests on no dimension."""
+    about = (verdict.seat_b, verdict.seat_a)
+    for seat, dims, estimate in zip(about, dimensions, estimates, strict=True):
+        answered = estimate is not Restriction.UNKNOWN and bool(dims.defaulted)
+        entered = seat.d3 is not Finding.NOT_EVALUATED or (
+            verdict.both_restricted and estimate is Restriction.RESTRICTED
+        )
+        if answered and entered:
+            return True
+    return False
 
 
 @dataclass(frozen=True)
@@ -721,7 +734,11 @@ def _pair_summary(
         role_final_a=verdict.role_final[0],
         role_final_b=verdict.role_final[1],
         give_way_vessels=_mmsi_list([v.mmsi for v in give_way]),
-        verdict_rests_on_defaults=_rests_on_defaults(verdict, (a.dimensions, b.dimensions)),
+        verdict_rests_on_defaults=_rests_on_defaults(
+            verdict,
+            (a.dimensions, b.dimensions),
+            (a.estimated_restricted, b.estimated_restricted),
+        ),
         range_m_at_trigger=float(trigger["range_m"]),
         cpa_m=float(trigger["cpa_m"]),
         tcpa_s=float(trigger["tcpa_s"]),

@@ -32,12 +32,14 @@ the same give-way vessel(s). This module is the one place that decides them:
 2. Overtaking: rule 13 keeps the roles whatever either vessel reports or is estimated (rule 18
    opens "except where Rules 9, 10 and 13 otherwise require"); the paths are still recorded.
 3. A vessel is restricted when the other seat's G_d reached D4 about her (she had to give
-   way and is restricted), or when her AIS status claims it (a status in the restricted set,
-   or not under command, restricted, constrained by her draught) even as the stand-on
-   vessel. Exactly one restricted vessel stands on and the other gives way; the deciding rule
-   is 9 when the estimator said so (d3: she can navigate safely only within the channel), 18
-   when her AIS status did.
-4. Both restricted: the rules 13–15 roles stay, flagged ``both_restricted``.
+   way and is restricted), or, even as the stand-on vessel, when her AIS status claims it (a
+   status in the restricted set, or not under command, restricted, constrained by her
+   draught) or the estimator finds her restricted. Exactly one restricted vessel stands on
+   and the other gives way; the deciding rule is 9 when the estimator said so (d3: she can
+   navigate safely only within the channel), 18 when her AIS status did.
+4. Both restricted: the rules 13–15 roles stay, flagged ``both_restricted``. Rule 9 asks
+   the vessel that can leave the channel to keep out of the way of one that cannot; when
+   neither can, it does not choose between them.
 5. Otherwise rule 18 where AIS says so: of a vessel not under command or restricted in her
    ability to manoeuvre (status 2, 3), constrained by her draught (4), engaged in fishing (7)
    and sailing (8), ranked in that order of rule 18, the lower-ranked vessel keeps out of the
@@ -286,11 +288,16 @@ def decide_pair(
     role_a, role_b = role_colregs
     seat_a = assess_rule9(role_b, nav_status[1], estimated_restricted[1], restricted_nav_statuses)
     seat_b = assess_rule9(role_a, nav_status[0], estimated_restricted[0], restricted_nav_statuses)
-    # A vessel is restricted when G_d reached D4 about her, or when she says so on AIS even
-    # as the stand-on vessel: then the other, if restricted too, cannot be made to stand on.
-    restricted = (
-        seat_b.rule9_applied or _claims_restriction(nav_status[0], restricted_nav_statuses),
-        seat_a.rule9_applied or _claims_restriction(nav_status[1], restricted_nav_statuses),
+    # A vessel is restricted when G_d reached D4 about her, or when her AIS status or the
+    # estimator says so even as the stand-on vessel: then the other, restricted too, cannot
+    # be made to stand on by rule 9.
+    restricted = tuple(
+        seat.rule9_applied
+        or _claims_restriction(status, restricted_nav_statuses)
+        or str(estimate) == "true"
+        for seat, status, estimate in zip(
+            (seat_b, seat_a), nav_status, estimated_restricted, strict=True
+        )
     )
     final = role_colregs
     rule = _STEERING_RULE[situation]

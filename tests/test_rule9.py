@@ -236,6 +236,8 @@ PAIR_CASES = [
     (CR, (SO, GW), (0, 0), ("false", "false"), (SO, GW), R15, False),
     # the same from a restricted stand-on vessel: nothing to invert
     (CR, (SO, GW), (0, 0), ("true", "false"), (SO, GW), R15, False),
+    # both estimated restricted: rule 9 does not choose between them, rule 15 stays
+    (CR, (SO, GW), (0, 0), ("true", "true"), (SO, GW), R15, True),
     # b reports restricted manoeuvrability (D1>D2>D4 in a's seat): rule 18
     (CR, (SO, GW), (0, 3), ("false", "false"), (GW, SO), R18, False),
     # head-on, b restricted: she is not expected to give way (rule 18 / rule 9)

@@ -1,0 +1,60 @@
+"""Checks shared by the replay tests: both seats of a pair tell the same story."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+
+def _seat_pairs(table: pd.DataFrame) -> pd.DataFrame:
+    """Each pair's two seats side by side (suffix _other for the mirrored seat)."""
+    mirrored = table.merge(
+        table,
+        left_on=["pair_id", "own_mmsi", "target_mmsi"],
+        right_on=["pair_id", "target_mmsi", "own_mmsi"],
+        suffixes=("", "_other"),
+    )
+    return mirrored[mirrored["own_mmsi"] < mirrored["target_mmsi"]]
+
+
+PAIR_LEVEL_COLUMNS = (
+    "situation",
+    "situation_ambiguous",
+    "situation_basis",
+    "give_way_vessels",
+    "deciding_rule",
+    "rule9_applied",
+    "both_restricted",
+    "data_covers_cpa",
+    "actual_min_separation_m",
+    "give_way_vessel_acted",
+    "give_way_action",
+    "stand_on_vessel_kept_course",
+    "trigger_utc",
+)
+
+
+def assert_seats_agree(table: pd.DataFrame) -> int:
+    """Every pair seen from both seats has one situation and one set of give-way vessels,
+    and a crossing has exactly one give-way vessel. Returns the number of pairs checked."""
+    pairs = _seat_pairs(table)
+    for column in PAIR_LEVEL_COLUMNS:
+        left, right = pairs[column], pairs[f"{column}_other"]
+        assert ((left == right) | (left.isna() & right.isna())).all(), column
+    assert (pairs["own_role_final"] == pairs["target_role_final_other"]).all()
+    assert (pairs["own_role_colregs"] == pairs["target_role_colregs_other"]).all()
+    assert (pairs["automaton_path"] == pairs["target_seat_automaton_path_other"]).all()
+    final_give_way = pairs["give_way_vessels"].str.split(";").str.len()
+    assert (final_give_way[pairs["situation"] == "crossing"] == 1).all()
+    assert (final_give_way[pairs["situation"] == "overtaking"] == 1).all()
+    for row in pairs.itertuples():
+        named = set(str(row.give_way_vessels).split(";"))
+        by_role = {
+            str(m)
+            for m, role in (
+                (row.own_mmsi, row.own_role_final),
+                (row.target_mmsi, row.target_role_final),
+            )
+            if role == "give-way"
+        }
+        assert named == by_role
+    return len(pairs)

@@ -1,0 +1,79 @@
+"""A real audit end to end: real MarineCadastre AIS in San Diego Bay over the real NOAA ENC
+US5CA72M (with its update files), so that the estimator runs on real depths."""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+import pytest
+
+from colregs9_cli.replay import run_replay
+
+from fixture_files import SANDIEGO_AIS, SANDIEGO_ENC
+from seat_checks import assert_seats_agree
+
+TRIGGERED_SEATS = 38  # 19 pairs, each from both seats
+
+
+@pytest.fixture(scope="module")
+def sandiego(tmp_path_factory: pytest.TempPathFactory):
+    out = tmp_path_factory.mktemp("sandiego")
+    return run_replay([SANDIEGO_AIS], chart_paths=[SANDIEGO_ENC], out_dir=out, plots=False)
+
+
+def _table(result, name: str) -> pd.DataFrame:
+    return pd.read_csv(result.out_dir / name, dtype=str, keep_default_na=False)
+
+
+def test_every_pair_has_one_situation_and_one_set_of_give_way_vessels(sandiego) -> None:
+    encounters = pd.read_csv(
+        sandiego.out_dir / "encounters.csv",
+        dtype={"give_way_vessels": str, "deciding_rule": str, "give_way_action": str},
+    )
+    assert len(encounters) == TRIGGERED_SEATS
+    assert assert_seats_agree(encounters) == TRIGGERED_SEATS // 2
+    pairs = _table(sandiego, "pairs.csv")
+    assert len(pairs) == TRIGGERED_SEATS // 2
+    crossing = pairs[pairs["situation"] == "crossing"]
+    assert len(crossing) > 0
+    assert (crossing["give_way_vessels"].str.count(";") == 0).all()
+
+
+def test_the_estimator_runs_on_real_depths(sandiego) -> None:
+    pairs = _table(sandiego, "pairs.csv")
+    estimates = pd.concat([pairs["estimated_restricted_a"], pairs["estimated_restricted_b"]])
+    # real depth areas: some vessels are restricted, others have room
+    assert {"true", "false"} <= set(estimates)
+    # Class B craft report no draught: every verdict that used such an estimate says so
+    assert (pairs["verdict_rests_on_defaults"] == "true").sum() > 0
+    defaulted = (pairs["defaulted_dimensions_a"] != "") | (pairs["defaulted_dimensions_b"] != "")
+    assert (
+        pairs.loc[pairs["verdict_rests_on_defaults"] == "true"].index.isin(pairs[defaulted].index)
+    ).all()
+    manifest = json.loads((sandiego.out_dir / "run.json").read_text(encoding="utf-8"))
+    assert manifest["verdicts"]["pairs"] == TRIGGERED_SEATS // 2
+    assert manifest["ledger_balanced"]
+
+
+def test_small_craft_take_small_craft_dimensions(sandiego) -> None:
+    encounters = _table(sandiego, "encounters.csv")
+    source = pd.read_csv(SANDIEGO_AIS)
+    class_b = set(source.loc[source["TransceiverClass"] == "B", "MMSI"].astype(str))
+    no_draught = encounters[encounters["target_dimensions_defaulted"].str.contains("draught")]
+    small = no_draught[no_draught["target_mmsi"].isin(class_b)]
+    assert len(small) > 0
+    # a Class B pleasure or sailing craft never gets the 3.2 m of a Class A merchant vessel
+    assert (small["target_draught_m"].astype(float) <= 2.0).all()
+    class_a = no_draught[~no_draught["target_mmsi"].isin(class_b)]
+    assert (class_a["target_draught_m"].astype(float) >= 3.0).all()
+
+
+def test_no_audit_fact_on_data_that_stops(sandiego) -> None:
+    pairs = _table(sandiego, "pairs.csv")
+    stops = pairs["data_covers_cpa"] == "false"
+    assert (pairs.loc[stops, "actual_min_separation_m"] == "").all()
+    for column in ("give_way_vessel_acted", "stand_on_vessel_kept_course"):
+        assert set(pairs.loc[stops, column]) <= {"insufficient-data", ""}, column
+    covered = pairs[~stops]
+    assert (covered["actual_min_separation_m"].astype(float) > 0).all()
