@@ -105,6 +105,11 @@ def test_boundaries_while_closing(
     assert result.own_role[0] is own_role
     assert result.target_role[0] is target_role
     assert bool(result.own_overtaking[0]) is own_overtaking
+    # the other seat: the same situation, the roles swapped
+    other = classify(beta_prime, beta, True, PARAMS)
+    assert other.situation[0] is situation
+    assert (other.own_role[0], other.target_role[0]) == (target_role, own_role)
+    assert other.ambiguous[0] == result.ambiguous[0]
 
 
 @pytest.mark.parametrize(("beta", "beta_prime"), [(c[0], c[1]) for c in BOUNDARY_CASES])
