@@ -44,9 +44,19 @@ if TYPE_CHECKING:
     from .geo import LocalFrame
 
 TOP_LEVEL_KEYS = frozenset(
-    {"name", "description", "region", "time", "vessels", "manoeuvrability", "colregs", "replay"}
+    {
+        "name",
+        "description",
+        "region",
+        "time",
+        "vessels",
+        "ingest",
+        "manoeuvrability",
+        "colregs",
+        "replay",
+    }
 )
-STAGE_TABLES = ("manoeuvrability", "colregs", "replay")
+STAGE_TABLES = ("ingest", "manoeuvrability", "colregs", "replay")
 REGION_KEYS = frozenset({"lat_min", "lat_max", "lon_min", "lon_max", "polygon", "polygon_file"})
 TIME_KEYS = frozenset({"start", "end"})
 VESSEL_KEYS = frozenset(

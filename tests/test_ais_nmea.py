@@ -17,7 +17,7 @@ from pyais import encode_dict
 from colregs9_cli.ais.batch import AisBatch
 from colregs9_cli.ais.clean import SHIP_TYPE_CATEGORIES
 from colregs9_cli.ais.ledger import RejectReason, RejectsLedger
-from colregs9_cli.ais.nmea import read_nmea
+from colregs9_cli.ais.nmea import TimeSource, pghp_time_ms, read_nmea
 from colregs9_cli.errors import InputFileError
 
 NOON = 1_384_257_600  # 2013-11-12 12:00:00 UTC
@@ -91,11 +91,12 @@ def _rows(table: object) -> list[dict[str, object]]:
 # -- input forms ----------------------------------------------------------------------------
 
 
-def test_pghp_line_stamps_the_next_sentence_floored_to_the_second() -> None:
+def test_pghp_line_stamps_the_next_sentence_to_the_millisecond() -> None:
     when = datetime(2013, 11, 12, 12, 0, 7, 979_000, tzinfo=UTC)
-    batch, _ = _read([_tag("si:AISD"), _pghp(when), _position()])
+    batch, ledger = _read([_tag("si:AISD"), _pghp(when), _position()])
     (row,) = _rows(batch.positions)
-    assert row["timestamp"] == datetime(2013, 11, 12, 12, 0, 7, tzinfo=UTC)
+    assert row["timestamp"] == when
+    assert ledger.time_sources == {"pghp": 1}
     assert row["mmsi"] == 219000001
     assert row["mobile_type"] == "Class A"
 
@@ -107,12 +108,17 @@ def test_tag_block_c_on_the_same_line() -> None:
 
 def test_tag_block_c_in_milliseconds_and_alone_on_the_line_before() -> None:
     batch, _ = _read([_tag(f"c:{(NOON + 5) * 1000 + 900}"), _position()])
-    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 0, 5, tzinfo=UTC)
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(
+        2013, 11, 12, 12, 0, 5, 900_000, tzinfo=UTC
+    )
 
 
 def test_trailing_unix_time_after_the_checksum() -> None:
-    batch, _ = _read([f"{_position()},{NOON + 61}.75"])
-    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 1, 1, tzinfo=UTC)
+    batch, ledger = _read([f"{_position()},{NOON + 61}.75"])
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(
+        2013, 11, 12, 12, 1, 1, 750_000, tzinfo=UTC
+    )
+    assert ledger.time_sources == {"arrival": 1}
 
 
 def test_a_tag_block_c_beats_a_pending_pghp_time() -> None:
@@ -518,9 +524,12 @@ def test_dma_fixture_counts(dma: tuple[AisBatch, RejectsLedger]) -> None:
     assert positions["mobile_type"].value_counts().to_dict() == {"Class A": 24_195, "Class B": 493}
     # Type 18 has no navigational status; every Class A report here has one.
     assert positions["nav_status"].notna().sum() == 24_195
-    first = pd.Timestamp("2013-11-12 12:00:00", tz="UTC")
-    assert positions["timestamp"].min() == first
-    assert positions["timestamp"].max() == first + pd.Timedelta(seconds=299)
+    # $PGHP times to the millisecond (the first and last lines of the file)
+    assert positions["timestamp"].min() == pd.Timestamp("2013-11-12 12:00:00.011", tz="UTC")
+    assert positions["timestamp"].max() == pd.Timestamp("2013-11-12 12:04:59.979", tz="UTC")
+    assert (positions["timestamp"].dt.microsecond % 1000 == 0).all()
+    assert (positions["timestamp"].dt.microsecond != 0).mean() > 0.99
+    assert dma[1].time_sources == {"pghp": 26_077}  # every message, DMA stamps each
 
 
 def test_dma_fixture_limfjord_box(dma: tuple[AisBatch, RejectsLedger]) -> None:
@@ -556,3 +565,80 @@ def test_dma_fixture_static_join(dma: tuple[AisBatch, RejectsLedger]) -> None:
     assert set(vessel["ship_type"]) == {"Fishing"}
     assert set(vessel["name"]) == {"O-156"}
     assert vessel["imo"].isna().all()
+
+
+# --- satellite $PGHP and the precedence of time sources ----------------------------------
+
+
+def _satellite_pghp(when: datetime) -> str:
+    # exactEarth/AMSA style: the origin of the message (satellite) where DMA writes its site
+    body = f"PGHP,1,{when:%Y,%m,%d,%H,%M,%S},{when.microsecond // 1000},,,1AIS_S,,"
+    return f"${body}*{_checksum(body)}"
+
+
+def test_satellite_pghp_keeps_the_observation_time_not_the_arrival() -> None:
+    observed = datetime(2013, 11, 12, 12, 3, 14, 159_000, tzinfo=UTC)
+    arrival = NOON + 3600 + 17 * 60  # 77 min later, as satellite feeds arrive
+    batch, ledger = _read([_satellite_pghp(observed), f"{_position()},{arrival}"])
+    (row,) = _rows(batch.positions)
+    assert row["timestamp"] == observed
+    assert ledger.time_sources == {"pghp": 1}
+
+
+def test_time_source_order_is_a_parameter() -> None:
+    observed = datetime(2013, 11, 12, 12, 3, 14, tzinfo=UTC)
+    lines = [_satellite_pghp(observed), f"{_position()},{NOON + 600}"]
+    ledger = RejectsLedger()
+    (batch,) = read_nmea(lines, "log.nmea", ledger, (TimeSource.ARRIVAL, TimeSource.PGHP))
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 10, tzinfo=UTC)
+    assert ledger.time_sources == {"arrival": 1}
+    # leaving a source out: no time at all is unparseable, counted, never guessed
+    ledger = RejectsLedger()
+    (batch,) = read_nmea([_position() + f",{NOON}"], "log.nmea", ledger, (TimeSource.PGHP,))
+    assert batch.positions.num_rows == 0 and ledger.rejects == {"unparseable": 1}
+
+
+@pytest.mark.parametrize(
+    "line",
+    [
+        "$PGHP,1,2013,11,12,12,0,7,979,219,,2190067,1,00*00",  # wrong checksum
+        "$PGHP,1,2013,02,30,12,0,7,979",  # no such day (checksum added below)
+        "$PGHP,1,2013,11,12,12,0,7",  # no milliseconds field
+    ],
+)
+def test_a_bad_pghp_gives_no_time(line: str) -> None:
+    if "*" not in line:
+        line = f"{line}*{_checksum(line[1:])}"
+    assert pghp_time_ms(line) is None
+
+
+def test_pghp_time_ms_reads_dma_and_satellite_lines() -> None:
+    dma = "$PGHP,1,2013,11,12,12,0,0,11,219,,2190067,1,62*26"  # the first line of the fixture
+    assert pghp_time_ms(dma) == (NOON * 1000) + 11
+    when = datetime(2020, 2, 29, 23, 59, 59, 999_000, tzinfo=UTC)
+    assert pghp_time_ms(_satellite_pghp(when)) == round(when.timestamp() * 1000)
+
+
+def test_a_query_sets_the_precedence_and_the_ledger_records_it(tmp_path) -> None:
+    from types import MappingProxyType
+
+    from colregs9_cli.ais.load import load_ais
+    from colregs9_cli.query import Query
+
+    observed = datetime(2013, 11, 12, 12, 3, 14, 159_000, tzinfo=UTC)
+    second = _position()
+    log = tmp_path / "satellite.nmea"
+    log.write_text(
+        "\n".join([_satellite_pghp(observed), f"{second},{NOON + 4000}"]) + "\n", encoding="ascii"
+    )
+    by_default = load_ais([log], fmt="nmea")
+    assert by_default.positions["timestamp"].iloc[0] == observed
+    assert by_default.ledger.to_dict()["time_sources"] == {"pghp": 1}
+    assert by_default.ledger.to_dict()["time_source_order"] == ["tag_block", "pghp", "arrival"]
+    arrival_first = Query(
+        name="arrival",
+        tables=MappingProxyType({"ingest": MappingProxyType({"nmea_time_sources": ["arrival"]})}),
+    )
+    data = load_ais([log], query=arrival_first, fmt="nmea")
+    assert data.positions["timestamp"].iloc[0] == datetime(2013, 11, 12, 13, 6, 40, tzinfo=UTC)
+    assert data.ledger.to_dict()["time_source_order"] == ["arrival"]

@@ -6,7 +6,9 @@ import dataclasses
 import re
 import tomllib
 
+from colregs9_cli.ais.nmea import IngestParams
 from colregs9_cli.colregs import ColregsParams, colregs_params_from_table
+from colregs9_cli.config import dataclass_from_table
 from colregs9_cli.manoeuvrability import ManoeuvrabilityParams
 from colregs9_cli.replay_params import ReplayParams, replay_params_from_table
 
@@ -32,8 +34,9 @@ def _commented_out_keys() -> set[str]:
 
 def test_documented_stage_tables_are_the_defaults() -> None:
     tables = _documented_tables()
-    assert set(tables) == {"manoeuvrability", "colregs", "replay"}
+    assert set(tables) == {"ingest", "manoeuvrability", "colregs", "replay"}
     where = "queries/README.md"
+    assert dataclass_from_table(IngestParams, tables["ingest"], where) == IngestParams()
     assert ManoeuvrabilityParams.from_table(tables["manoeuvrability"], where) == (
         ManoeuvrabilityParams()
     )
@@ -47,6 +50,7 @@ def test_every_parameter_is_documented() -> None:
         ("manoeuvrability", ManoeuvrabilityParams),
         ("colregs", ColregsParams),
         ("replay", ReplayParams),
+        ("ingest", IngestParams),
     ):
         fields = {f.name for f in dataclasses.fields(cls) if f.init}
         unset = {f.name for f in dataclasses.fields(cls) if f.init and f.default is None}

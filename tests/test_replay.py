@@ -46,9 +46,11 @@ from seat_checks import assert_seats_agree
 KNOT_MPS = 1852.0 / 3600.0
 GEOD = Geod(ellps="WGS84")
 
-# The replay pipeline finds 13 close-quarters pairs in the sample, each reported from both
+# The replay pipeline finds 12 close-quarters pairs in the sample, each reported from both
 # sides. Every one of them is re-checked by hand below (CPA < 150 m, 0 <= TCPA <= 180 s).
-NATIONAL_TRIGGERED = 26
+# (With times floored to the second there were 13: a second encounter of 211440340 and
+# 211457700 came out at CPA 149.9 m, which the millisecond times put above 150 m.)
+NATIONAL_TRIGGERED = 24
 # 24,688 vessel positions (fixtures/SOURCES.md), before duplicates and speed jumps.
 NATIONAL_POSITIONS = 24_688
 
@@ -165,13 +167,14 @@ def test_national_sample_seats_agree(national) -> None:
     assert list(pairs.columns) == list(PAIR_COLUMNS)
     assert len(pairs) == NATIONAL_TRIGGERED // 2
     assert set(pairs["pair_id"]) == set(table["pair_id"])
-    # The two contradictory pairs: now one head-on in doubt and one crossing.
+    # The two contradictory pairs (bearings 353.9°/352.5° and 31.4°/10.0° with whole
+    # seconds): now a head-on in which both give way, and a crossing with one give-way vessel.
     by_pair = pairs.set_index(["mmsi_a", "mmsi_b"])
     assert by_pair.loc[("219230000", "219622000"), "situation"] == "head-on"
-    assert by_pair.loc[("219230000", "219622000"), "situation_basis"] == "head-on in doubt"
+    assert by_pair.loc[("219230000", "219622000"), "give_way_vessels"] == "219230000;219622000"
     first = by_pair.loc[("211440340", "211457700")]
-    assert (first["situation"] == "crossing").all()
-    assert (first["give_way_vessels"].str.count(";") == 0).all()
+    assert first["situation"] == "crossing"
+    assert first["give_way_vessels"].count(";") == 0
 
 
 def test_no_audit_fact_is_judged_on_data_that_stops(national) -> None:
@@ -269,7 +272,7 @@ def test_national_ledger_counts_track_drops(national, raw_reports: pd.DataFrame)
     assert tracks["same_time_dropped"] == same_second
     assert tracks["reports_used"] == len(distinct) - same_second - tracks["speed_jump_dropped"]
     duplicates = len(valid) - len(distinct) + same_second
-    assert ledger["rejects_by_reason"]["duplicate"] == duplicates
+    assert ledger["rejects_by_reason"].get("duplicate", 0) == duplicates
     assert ledger["rejects_by_reason"]["speed_jump"] == tracks["speed_jump_dropped"]
 
 

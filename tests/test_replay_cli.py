@@ -65,17 +65,17 @@ def test_replay_prints_a_summary_and_writes_the_reports(tmp_path: Path) -> None:
     for pair_id in pairs["pair_id"]:
         assert pair_id in result.output
     assert len(result.output.splitlines()) == len(pairs) + 3
-    assert "26 triggered" in result.output
+    assert "24 triggered" in result.output
     assert f"Reports in {tmp_path}" in result.output
     assert not list((tmp_path / "encounters").glob("*.png"))
-    assert len(list((tmp_path / "encounters").glob("*.csv"))) == len(table) == 26
+    assert len(list((tmp_path / "encounters").glob("*.csv"))) == len(table) == 24
 
 
 def test_cli_overrides_reach_the_trigger(tmp_path: Path) -> None:
     result = _invoke(str(NMEA), "--no-plots", "--out", str(tmp_path), "--cpa-req-m", "20")
     assert result.exit_code == 0, result.output
     table = pd.read_csv(tmp_path / "encounters.csv")
-    assert 0 < len(table) < 26
+    assert 0 < len(table) < 24
     assert (table["cpa_m"] < 20).all()
 
 

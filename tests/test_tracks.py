@@ -291,26 +291,25 @@ def test_real_nmea_sample(fixtures_dir: Path) -> None:
         positions["lon_deg"].max(),
     )
     tracks = build_tracks(positions, frame, ReplayParams())
-    # Cross-checked with pandas on the same positions: 53 rows repeat an (mmsi, timestamp);
-    # the longest gap between a vessel's reports is 258 s (< 300, no gap split); after
-    # dropping the repeats, 21 consecutive pairs imply > 50 kn, all from three fast craft:
-    # 219017081 (≈34 kn, 17 isolated spikes from 1 s timestamp jitter: dropped),
-    # 235011610 (one 55 kn spike: dropped) and 219601000 (≈36 kn; three times a stale
-    # repeated position is followed by a jump that the next report confirms: split).
-    # The vessels' spans (last − first + 1 s) sum to 284,219 s; each split removes the one
-    # grid second between two reports 2 s apart, so 284,216 samples.
+    # With the $PGHP milliseconds no (mmsi, timestamp) repeats (floored to the second, 53
+    # did). The longest gap between a vessel's reports is 258 s (< 300, no gap split). Four
+    # reports imply > 50 kn from the last kept one and are dropped: with whole seconds it was
+    # 18, 17 of them 1 s timestamp jitter of the ≈34 kn craft 219017081. 219601000 (≈36 kn)
+    # still repeats a stale position three times, then jumps, confirmed by the next report:
+    # split. Resampling never extrapolates, so a vessel whose reports all fall inside one
+    # grid second has no sample: 1,112 of the 1,438 vessels have samples.
     assert tracks.stats == TrackStats(
         reports_in=24688,
-        reports_used=24688 - 53 - 18,
-        same_time_dropped=53,
-        speed_jump_dropped=18,
+        reports_used=24688 - 4,
+        same_time_dropped=0,
+        speed_jump_dropped=4,
         jump_splits=3,
         gap_splits=0,
         segments=1438 + 3,
-        samples=284216,
+        samples=282777,
     )
-    assert len(tracks.vessels) == 1438
-    assert tracks.samples["mmsi"].nunique() == 1438
+    assert len(tracks.vessels) == 1112
+    assert tracks.samples["mmsi"].nunique() == 1112
     split_vessels = tracks.samples.groupby("mmsi")["segment_id"].nunique()
     assert split_vessels[split_vessels > 1].to_dict() == {219601000: 4}
 

@@ -101,7 +101,7 @@ def dma_canonical(batch: pa.RecordBatch, has_abcd: bool) -> tuple[pa.Table, Bool
     imo, _ = float_column(clean_text(batch.column("imo")))
     table = pa.table(
         {
-            "timestamp": stamps.cast(pa.timestamp("s", tz="UTC")),
+            "timestamp": stamps.cast(pa.timestamp("ms", tz="UTC")),
             "mmsi": pa.array(mmsi, pa.int64()),
             "lat_deg": nan_to_null(null_outside(lat, -90.0, 90.0)),
             "lon_deg": nan_to_null(null_outside(lon, -180.0, 180.0)),

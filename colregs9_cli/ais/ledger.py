@@ -31,6 +31,9 @@ class RejectsLedger:
     rows_used: int = 0
     rows_outside_query: int = 0
     rejects: Counter[str] = field(default_factory=Counter)
+    # Rows by the source of their time, where a layout has several (NMEA: nmea.TimeSource).
+    time_sources: Counter[str] = field(default_factory=Counter)
+    time_source_order: tuple[str, ...] = ()  # the precedence the reader used
     # Examples of rejected rows, for the manifest: reason -> a few "file:line: value" strings.
     examples: dict[str, list[str]] = field(default_factory=dict)
     max_examples: int = 5
@@ -73,4 +76,12 @@ class RejectsLedger:
             "rows_rejected": self.rejected_total,
             "rejects_by_reason": dict(sorted(self.rejects.items())),
             "reject_examples": self.examples,
+            **(
+                {
+                    "time_sources": dict(sorted(self.time_sources.items())),
+                    "time_source_order": list(self.time_source_order),
+                }
+                if self.time_sources
+                else {}
+            ),
         }

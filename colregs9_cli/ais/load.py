@@ -179,6 +179,8 @@ def _merge_ledger(into: RejectsLedger, part: RejectsLedger) -> None:
     into.outside_query(part.rows_outside_query)
     for reason, count in part.rejects.items():
         into.rejects[reason] += count
+    into.time_sources.update(part.time_sources)
+    into.time_source_order = into.time_source_order or part.time_source_order
     for reason, examples in part.examples.items():
         bucket = into.examples.setdefault(reason, [])
         bucket.extend(examples[: max(0, into.max_examples - len(bucket))])
@@ -591,11 +593,12 @@ def _in_query(table: pa.Table, query: Query) -> np.ndarray:
     keep = np.ones(table.num_rows, dtype=bool)
     window = query.time
     if not window.unbounded:
-        seconds = table.column("timestamp").cast(pa.int64()).to_numpy()
+        # the schema's unit: milliseconds since the epoch
+        milliseconds = table.column("timestamp").cast(pa.int64()).to_numpy()
         if window.start is not None:
-            keep &= seconds >= int(window.start.timestamp())
+            keep &= milliseconds >= round(window.start.timestamp() * 1000)
         if window.end is not None:
-            keep &= seconds < int(window.end.timestamp())
+            keep &= milliseconds < round(window.end.timestamp() * 1000)
     if not query.vessels.selects_all:
         keep &= query.vessels.selects(
             table.column("mmsi").to_numpy(),
@@ -665,13 +668,19 @@ def _table_example(name: str, table: pa.Table) -> Example:
 
 
 def _read_nmea(source: Source, query: Query, bar: ProgressSink) -> _FileResult:
-    from .nmea import read_nmea
+    from ..config import dataclass_from_table
+    from .nmea import IngestParams, read_nmea
+
+    where = f"{query.source if query.source is not None else 'query'} [ingest]"
+    ingest = dataclass_from_table(IngestParams, dict(query.tables.get("ingest", {})), where)
 
     result = _FileResult(query, source.name, _table_conversion(source.name, None), layout="nmea")
     with open_data(source, bar) as opened:
         text = io.TextIOWrapper(opened.stream, encoding="utf-8", errors="replace", newline="")
         try:
-            batches = list(read_nmea(_lines(text), source.name, result.ledger))
+            batches = list(
+                read_nmea(_lines(text), source.name, result.ledger, ingest.nmea_time_sources)
+            )
         except (EOFError, OSError) as exc:
             raise decompression_error(source, exc) from None
         result.sha256 = opened.finish()

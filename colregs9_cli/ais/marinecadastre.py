@@ -104,7 +104,7 @@ def marinecadastre_canonical(batch: pa.RecordBatch) -> tuple[pa.Table, BoolArray
     length, breadth, draught = _dimensions(batch)
     table = pa.table(
         {
-            "timestamp": stamps.cast(pa.timestamp("s", tz="UTC")),
+            "timestamp": stamps.cast(pa.timestamp("ms", tz="UTC")),
             "mmsi": pa.array(mmsi, pa.int64()),
             "lat_deg": nan_to_null(null_outside(float_column(batch.column("lat"))[0], -90.0, 90.0)),
             "lon_deg": nan_to_null(

@@ -1,14 +1,24 @@
 """Raw NMEA AIS logs (``!AIVDM``/``!BSVDM``/...), decoded with pyais, in the canonical schema.
 
-Timestamps. A message takes its time from, in this order: a tag block with ``c:`` on the
-sentence's line (``\\s:rORBCOMM,c:1384257600*hh\\!AIVDM,...``), a trailing ``,<unix time>``
-after the checksum, or a pending time set by the line before: DMA's
-``$PGHP,1,Y,M,D,h,m,s,ms,...`` or a stand-alone tag block line with ``c:``. Any sentence
-line (AIS or not) consumes the pending time, because ``$PGHP`` stamps exactly the next
-sentence. A tag block whose checksum fails gives no time. ``c:`` values above 1e11 are taken
-as milliseconds. Times are floored to the second (the schema is ``timestamp[s, UTC]``). A
-message with no time from any of these is rejected as unparseable: without a time it cannot
-be placed in a track.
+Timestamps, kept to the millisecond. A sentence can carry up to three times (``TimeSource``):
+
+- ``tag_block``: a tag block ``c:`` on its own line (``\\s:rORBCOMM,c:1384257600*hh\\!AIVDM,...``)
+  or on a stand-alone tag block line just before it: the receiver's time of reception;
+- ``pghp``: a Gatehouse ``$PGHP,1,Y,M,D,h,m,s,ms,...`` line just before it (the DMA feed;
+  satellite feeds write their origin, e.g. ``1AIS_S``, in the fields after the time, and any
+  field after the milliseconds is accepted): the base station's or satellite's time of
+  reception, with milliseconds;
+- ``arrival``: a trailing ``,<unix time>`` after the checksum: when the line reached the
+  archive, which for satellite data is minutes to hours after the observation.
+
+The observation wins over the arrival: by default ``tag_block``, then ``pghp``, then
+``arrival`` (``DEFAULT_TIME_SOURCES``; ``read_nmea``'s ``time_sources`` changes the order or
+leaves a source out). Each message's source is counted in the ledger (``time_sources``). Any
+sentence line (AIS or not) consumes the pending times, because ``$PGHP`` stamps exactly the
+next sentence. A tag block whose checksum fails gives no time; so does a ``$PGHP`` line whose
+checksum or date fails. ``c:`` and trailing values above 1e11 are taken as milliseconds. A
+message with no time from the sources in use is rejected as unparseable: without a time it
+cannot be placed in a track.
 
 Multi-sentence messages are reassembled per (sentence tag, channel, sequential id, fragment
 count), so interleaved messages on other channels or ids do not disturb each other. A group
@@ -48,10 +58,10 @@ long-range broadcast of SOLAS ships) is "Class A".
 
 from __future__ import annotations
 
-import math
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from datetime import UTC
+from datetime import UTC, datetime
+from enum import StrEnum
 from typing import cast
 
 import numpy as np
@@ -60,7 +70,6 @@ import pyarrow as pa
 from pyais.exceptions import AISBaseException
 from pyais.messages import (
     AISSentence,
-    GatehouseSentence,
     MessageType1,
     MessageType5,
     MessageType18,
@@ -74,6 +83,7 @@ from pyais.messages import (
     TagBlock,
 )
 
+from ..errors import ParameterError
 from .batch import STATIC_SCHEMA, AisBatch
 from .clean import SHIP_TYPE_CATEGORIES
 from .ledger import RejectReason, RejectsLedger
@@ -89,6 +99,46 @@ _MOBILE_TYPE = {t: "Class B" if t in _CLASS_B_TYPES else "Class A" for t in POSI
 _EXAMPLE_CHARS = 160
 _MAX_UNIX_S = 4_102_444_800  # 2100-01-01: larger values are not plausible receive times
 _UNIX_MS_THRESHOLD = 1e11  # above this a c: value is milliseconds
+
+
+class TimeSource(StrEnum):
+    """Where a message's time came from (module docstring)."""
+
+    TAG_BLOCK = "tag_block"
+    PGHP = "pghp"
+    ARRIVAL = "arrival"
+
+
+DEFAULT_TIME_SOURCES: tuple[TimeSource, ...] = (
+    TimeSource.TAG_BLOCK,
+    TimeSource.PGHP,
+    TimeSource.ARRIVAL,
+)
+# A message's time: milliseconds since the epoch, and its source.
+_Stamp = tuple[int, TimeSource]
+
+
+@dataclass(frozen=True)
+class IngestParams:
+    """The ``[ingest]`` table of a query: how raw NMEA is read.
+
+    - ``nmea_time_sources``: the time sources to use, in order of precedence (module
+      docstring); the default puts the observation (``tag_block``, ``pghp``) before the
+      ``arrival`` at the archive.
+    """
+
+    nmea_time_sources: tuple[TimeSource, ...] = DEFAULT_TIME_SOURCES
+
+    def __post_init__(self) -> None:
+        names = [str(s) for s in self.nmea_time_sources]
+        allowed = [s.value for s in TimeSource]
+        bad = [n for n in names if n not in allowed]
+        if not names or bad or len(set(names)) != len(names):
+            raise ParameterError(
+                f"[ingest] nmea_time_sources = {names!r}: give each of {', '.join(allowed)} "
+                "at most once, at least one, in order of precedence"
+            )
+        object.__setattr__(self, "nmea_time_sources", tuple(TimeSource(n) for n in names))
 
 
 def _bits_through(cls: type[Payload], last_field: str) -> int:
@@ -136,11 +186,11 @@ class _Fragments:
 
     sentences: list[AISSentence]
     line_no: int
-    timestamp: int | None
+    timestamp: _Stamp | None
     raw: list[str]
     broken: bool = False
 
-    def add(self, sentence: AISSentence, timestamp: int | None, raw: str) -> None:
+    def add(self, sentence: AISSentence, timestamp: _Stamp | None, raw: str) -> None:
         if sentence.frag_num != len(self.sentences) + 1:
             self.broken = True
         self.sentences.append(sentence)
@@ -153,7 +203,7 @@ class _Fragments:
 class _Columns:
     """Decoded values as plain lists; sentinels are nulled later, on whole arrays."""
 
-    timestamp: list[int] = field(default_factory=list)
+    timestamp: list[int] = field(default_factory=list)  # milliseconds since the epoch
     mmsi: list[int] = field(default_factory=list)
     msg_type: list[int] = field(default_factory=list)
     lat: list[float | None] = field(default_factory=list)
@@ -188,10 +238,13 @@ _STATIC_ONLY = (
 
 
 class _NmeaReader:
-    def __init__(self, source_name: str, ledger: RejectsLedger) -> None:
+    def __init__(
+        self, source_name: str, ledger: RejectsLedger, time_sources: Sequence[TimeSource]
+    ) -> None:
         self.source_name = source_name
         self.ledger = ledger
-        self.pending_timestamp: int | None = None
+        self.time_sources = tuple(TimeSource(s) for s in time_sources)
+        self.pending: dict[TimeSource, int] = {}
         self.open_groups: dict[tuple[str, str, int | None, int], _Fragments] = {}
         self.positions = _Columns()
         self.statics = _Columns()
@@ -202,17 +255,17 @@ class _NmeaReader:
         text = line.strip()
         if not text:
             return
-        line_timestamp: int | None = None
+        line_tag_ms: int | None = None
         if text[0] == "\\":
             end = text.find("\\", 1)
             if end < 0:
                 self._unparseable(line_no, "tag block without closing backslash", text)
                 return
-            line_timestamp = self._tag_block_time(text[1:end])
+            line_tag_ms = self._tag_block_time(text[1:end])
             text = text[end + 1 :].strip()
             if not text:
-                if line_timestamp is not None:
-                    self.pending_timestamp = line_timestamp
+                if line_tag_ms is not None:
+                    self.pending[TimeSource.TAG_BLOCK] = line_tag_ms
                 return
         if text[0] == "$":
             self._other_sentence(text)
@@ -221,14 +274,17 @@ class _NmeaReader:
             self._unparseable(line_no, "not an NMEA sentence", line.strip())
             return
         if text[3:6].upper() not in ("VDM", "VDO"):
-            self.pending_timestamp = None
+            self.pending.clear()
             return
-        sentence_text, suffix_timestamp = _split_time_suffix(text)
-        timestamp = line_timestamp if line_timestamp is not None else suffix_timestamp
-        if timestamp is None:
-            timestamp = self.pending_timestamp
-        self.pending_timestamp = None
-        self._ais_sentence(line_no, sentence_text, timestamp)
+        sentence_text, arrival_ms = _split_time_suffix(text)
+        available = dict(self.pending)
+        self.pending.clear()
+        if line_tag_ms is not None:
+            available[TimeSource.TAG_BLOCK] = line_tag_ms
+        if arrival_ms is not None:
+            available[TimeSource.ARRIVAL] = arrival_ms
+        stamp = next(((available[s], s) for s in self.time_sources if s in available), None)
+        self._ais_sentence(line_no, sentence_text, stamp)
 
     def _tag_block_time(self, tag_block: str) -> int | None:
         if "c:" not in tag_block:
@@ -240,20 +296,16 @@ class _NmeaReader:
             return None
         if not block.is_valid:
             return None
-        return _unix_seconds(block.receiver_timestamp)
+        return _unix_ms(block.receiver_timestamp)
 
     def _other_sentence(self, text: str) -> None:
-        self.pending_timestamp = None
-        if text[:6].upper() != "$PGHP,":
-            return
-        try:
-            sentence = NMEASentenceFactory.produce(text.encode("ascii"))
-        except (UnicodeEncodeError, AISBaseException, ValueError):
-            return
-        if isinstance(sentence, GatehouseSentence) and sentence.is_valid:
-            self.pending_timestamp = math.floor(sentence.timestamp.replace(tzinfo=UTC).timestamp())
+        self.pending.clear()
+        if text[:6].upper() == "$PGHP,":
+            pghp_ms = pghp_time_ms(text)
+            if pghp_ms is not None:
+                self.pending[TimeSource.PGHP] = pghp_ms
 
-    def _ais_sentence(self, line_no: int, text: str, timestamp: int | None) -> None:
+    def _ais_sentence(self, line_no: int, text: str, timestamp: _Stamp | None) -> None:
         try:
             sentence = NMEASentenceFactory.produce(text.encode("ascii"))
         except (UnicodeEncodeError, AISBaseException, ValueError) as err:
@@ -292,19 +344,21 @@ class _NmeaReader:
 
     # -- messages ---------------------------------------------------------------------------
 
-    def _message(
-        self, sentence: AISSentence, line_no: int, timestamp: int | None, raw: str
-    ) -> None:
+    def _message(self, sentence: AISSentence, line_no: int, stamp: _Stamp | None, raw: str) -> None:
         self.ledger.read()
         msg_type = sentence.ais_id
-        if timestamp is None:
+        if stamp is None:
+            used = ", ".join(s.value for s in self.time_sources)
             self._reject_message(
                 RejectReason.UNPARSEABLE,
                 line_no,
-                "no time (no $PGHP line before it, no tag block c:, no trailing unix time)",
+                f"no time from the time sources in use ({used}): no $PGHP line before it, "
+                "no tag block c:, no trailing unix time",
                 raw,
             )
             return
+        timestamp, source = stamp
+        self.ledger.time_sources[source.value] += 1
         if not sentence.payload:
             self._reject_message(RejectReason.UNPARSEABLE, line_no, "empty payload", raw)
             return
@@ -427,14 +481,15 @@ def _append_static(
 
 
 def _split_time_suffix(text: str) -> tuple[str, int | None]:
-    """``!AIVDM,...,0*5C,1384257600`` -> (the sentence, 1384257600)."""
+    """``!AIVDM,...,0*5C,1384257600`` -> (the sentence, 1384257600000 ms)."""
     star = text.rfind("*")
     if star < 0 or len(text) <= star + 3 or text[star + 3] != ",":
         return text, None
-    return text[: star + 3], _unix_seconds(text[star + 4 :].rsplit(",", 1)[-1])
+    return text[: star + 3], _unix_ms(text[star + 4 :].rsplit(",", 1)[-1])
 
 
-def _unix_seconds(value: str | None) -> int | None:
+def _unix_ms(value: str | None) -> int | None:
+    """A unix time in seconds (or milliseconds, above 1e11) as integer milliseconds."""
     if not value:
         return None
     try:
@@ -445,7 +500,43 @@ def _unix_seconds(value: str | None) -> int | None:
         seconds /= 1000.0
     if not 0 < seconds < _MAX_UNIX_S:
         return None
-    return math.floor(seconds)
+    return round(seconds * 1000.0)
+
+
+def _nmea_checksum_ok(text: str) -> bool:
+    star = text.rfind("*")
+    if star < 1 or len(text) < star + 3:
+        return False
+    computed = 0
+    for char in text[1:star]:
+        computed ^= ord(char)
+    try:
+        return computed == int(text[star + 1 : star + 3], 16)
+    except ValueError:
+        return False
+
+
+def pghp_time_ms(text: str) -> int | None:
+    """The time of a Gatehouse ``$PGHP`` line in milliseconds, or None.
+
+    Fields: ``$PGHP,<type>,<year>,<month>,<day>,<hour>,<minute>,<second>,<millisecond>,...``.
+    What follows the milliseconds varies by feed (DMA: country, region, site MMSI, online
+    flag; satellite feeds: the origin, e.g. ``1AIS_S``) and is not read. The checksum must
+    match and the date must exist.
+    """
+    if not _nmea_checksum_ok(text):
+        return None
+    fields = text[: text.rfind("*")].split(",")
+    if len(fields) < 9:
+        return None
+    try:
+        year, month, day, hour, minute, second, millisecond = (int(f) for f in fields[2:9])
+        moment = datetime(year, month, day, hour, minute, second, tzinfo=UTC)
+    except ValueError:
+        return None
+    if not 0 <= millisecond < 1000:
+        return None
+    return round(moment.timestamp()) * 1000 + millisecond
 
 
 # -- tables ---------------------------------------------------------------------------------
@@ -517,8 +608,8 @@ def _ship_type_text(codes: pd.Series) -> pa.Array:
     return pa.array(text.where(text.notna(), None), type=pa.string())
 
 
-def _timestamps(seconds: pd.Series) -> pa.Array:
-    return pa.array(seconds.to_numpy(dtype=np.int64), type=pa.timestamp("s", tz="UTC"))
+def _timestamps(milliseconds: pd.Series) -> pa.Array:
+    return pa.array(milliseconds.to_numpy(dtype=np.int64), type=pa.timestamp("ms", tz="UTC"))
 
 
 def _optional(values: pd.Series | np.ndarray, dtype: pa.DataType) -> pa.Array:
@@ -596,14 +687,21 @@ def _statics_table(statics: pd.DataFrame) -> pa.Table:
     )
 
 
-def read_nmea(lines: Iterable[str], source_name: str, ledger: RejectsLedger) -> Iterator[AisBatch]:
+def read_nmea(
+    lines: Iterable[str],
+    source_name: str,
+    ledger: RejectsLedger,
+    time_sources: Sequence[TimeSource] = DEFAULT_TIME_SOURCES,
+) -> Iterator[AisBatch]:
     """Decode a raw NMEA AIS log into one batch of positions and static reports.
 
     ``lines`` are the log's text lines; ``source_name`` names the file in reject examples
     ("file:line: why: sentence"). Every AIS message is counted with ``ledger.read()`` and
     becomes one output row or one reject (see the module docstring for the rules).
+    ``time_sources``: which times to use, in order of precedence.
     """
-    reader = _NmeaReader(source_name, ledger)
+    reader = _NmeaReader(source_name, ledger, time_sources)
+    ledger.time_source_order = tuple(s.value for s in reader.time_sources)
     for line_no, line in enumerate(lines, start=1):
         reader.feed(line_no, line)
     reader.finish()

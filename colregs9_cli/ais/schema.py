@@ -11,7 +11,7 @@ import pyarrow as pa
 
 CANONICAL_SCHEMA = pa.schema(
     [
-        pa.field("timestamp", pa.timestamp("s", tz="UTC")),
+        pa.field("timestamp", pa.timestamp("ms", tz="UTC")),
         pa.field("mmsi", pa.int64()),
         pa.field("lat_deg", pa.float64()),
         pa.field("lon_deg", pa.float64()),
