@@ -47,6 +47,7 @@ from numpy.typing import ArrayLike, NDArray
 from .config import dataclass_from_table
 from .encounters import velocity_mps
 from .errors import ParameterError
+from .geo import course_in_tangent_plane
 from .replay_params import CourseSource
 from .units import wrap_deg
 
@@ -142,20 +143,39 @@ class Kinematics:
     speed_mps: ArrayLike
 
     @classmethod
-    def from_frame(cls, frame: pd.DataFrame, prefix: str) -> Kinematics:
-        """From columns ``<prefix>north_m`` … (e.g. ``encounter_series`` with ``own_``).
+    def pair_from_series(cls, series: pd.DataFrame) -> tuple[Kinematics, Kinematics]:
+        """Own ship and target of an ``encounter_series`` in own ship's tangent plane.
 
-        Courses are taken in the frame's grid north (``<prefix>cog_grid_deg``), because the
-        bearings between vessels are measured on grid positions; true courses would put every
-        sector boundary off by the meridian convergence.
+        Own ship sits at the origin; the target at ``rel_north_m``/``rel_east_m`` (true north
+        and east at own ship). Courses are true, the target's turned into own ship's plane,
+        so that no map frame enters the bearings between the vessels.
         """
-        return cls(
-            north_m=frame[f"{prefix}north_m"].to_numpy(dtype=float),
-            east_m=frame[f"{prefix}east_m"].to_numpy(dtype=float),
-            cog_deg=frame[f"{prefix}cog_grid_deg"].to_numpy(dtype=float),
-            heading_deg=frame[f"{prefix}heading_grid_deg"].to_numpy(dtype=float),
-            speed_mps=frame[f"{prefix}speed_mps"].to_numpy(dtype=float),
+        own_lat = series["own_lat_deg"].to_numpy(dtype=float)
+        own_lon = series["own_lon_deg"].to_numpy(dtype=float)
+        tgt_lat = series["target_lat_deg"].to_numpy(dtype=float)
+        tgt_lon = series["target_lon_deg"].to_numpy(dtype=float)
+
+        def target_course(column: str) -> NDArray[np.float64]:
+            return course_in_tangent_plane(
+                series[column].to_numpy(dtype=float), tgt_lat, tgt_lon, own_lat, own_lon
+            )
+
+        zeros = np.zeros(len(series))
+        own = cls(
+            north_m=zeros,
+            east_m=zeros,
+            cog_deg=series["own_cog_deg"].to_numpy(dtype=float),
+            heading_deg=series["own_heading_deg"].to_numpy(dtype=float),
+            speed_mps=series["own_speed_mps"].to_numpy(dtype=float),
         )
+        target = cls(
+            north_m=series["rel_north_m"].to_numpy(dtype=float),
+            east_m=series["rel_east_m"].to_numpy(dtype=float),
+            cog_deg=target_course("target_cog_deg"),
+            heading_deg=target_course("target_heading_deg"),
+            speed_mps=series["target_speed_mps"].to_numpy(dtype=float),
+        )
+        return own, target
 
     def course_deg(self, source: CourseSource) -> NDArray[np.float64]:
         cog = np.asarray(self.cog_deg, dtype=float)

@@ -2,20 +2,24 @@
 
 - ``cpa_tcpa``: closest point of approach under constant velocities.
 - ``find_encounters``: at each step, the pairs of moving vessels (SOG ≥ ``min_sog_kn``) within
-  ``candidate_range_m``, found with a grid of cells of that size (each vessel is compared only
-  with vessels in its own and the neighbouring cells), so the work grows with the number of
-  close pairs, not with the square of the number of vessels. An encounter is a maximal run of
-  consecutive steps in which a pair stays a candidate. It triggers at the first step of the run
-  with ``0 <= TCPA <= tcpa_act_s`` and ``CPA < cpa_req_m``.
+  ``candidate_range_m``, found with a grid of cubic cells of that size on the Earth-centred
+  positions (each vessel is compared only with vessels in its own and the neighbouring
+  cells), so the work grows with the number of close pairs, not with the square of the
+  number of vessels, and nothing depends on a map projection: it works at any latitude and
+  across the antimeridian. An encounter is a maximal run of consecutive steps in which a
+  pair stays a candidate. It triggers at the first step of the run with
+  ``0 <= TCPA <= tcpa_act_s`` and ``CPA < cpa_req_m``.
 - ``encounter_series``: one encounter's steps, own ship and target side by side, for the
   COLREGs evaluation, the rule 9 automaton and the reports.
 
-Velocities are over ground: SOG along COG, taken as the grid COG (``cog_grid_deg``, see
-``tracks``) because they are compared with positions in the frame.
+Ranges, CPA and TCPA come from the vessels' WGS84 positions and their true COG and SOG
+(``geo.ecef_m``, ``geo.velocity_ecef_mps``), never from the run's map frame: they agree with a
+geodesic computation to well under a millimetre at 2 nm, anywhere on Earth.
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Iterable
 from dataclasses import dataclass
 from itertools import pairwise
@@ -25,11 +29,15 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from .errors import NoDataError
+from .geo import ecef_m, in_tangent_plane, velocity_ecef_mps
 from .replay_params import ReplayParams
 from .tracks import STATE_COLUMNS, Tracks
 
-# Below this relative speed (m/s) the vessels keep their distance: TCPA 0, CPA = range.
-_STILL_MPS = 1e-6
+# Below this relative speed (m/s) the vessels keep their distance: TCPA 0, CPA = range. One
+# centimetre per second is a fifth of AIS's SOG resolution (0.1 kn): two vessels on the same
+# course and speed side by side differ by more than that only through the meridians'
+# convergence, which is not an approach.
+_STILL_MPS = 0.01
 # Vessel positions per batch of the pair search: bounds memory, keeps the work vectorised.
 _POINTS_PER_BATCH = 20_000
 
@@ -45,19 +53,33 @@ def cpa_tcpa(
     ``rel_*`` are the target's position minus own ship's and the target's velocity minus own
     ship's (north, east). ``TCPA = −(p·v)/|v|²`` and ``CPA = |p + v·TCPA|``. TCPA is negative
     when the vessels are opening (the closest point is past). With no relative motion
-    (|v| < 1 µm/s) the range never changes: TCPA is 0 and CPA is the current range.
+    (|v| < 1 cm/s) the range never changes: TCPA is 0 and CPA is the current range.
     """
-    p_n = np.asarray(rel_north_m, dtype=float)
-    p_e = np.asarray(rel_east_m, dtype=float)
-    v_n = np.asarray(rel_vn_mps, dtype=float)
-    v_e = np.asarray(rel_ve_mps, dtype=float)
-    speed_sq = v_n * v_n + v_e * v_e
-    moving = speed_sq >= _STILL_MPS * _STILL_MPS
-    with np.errstate(invalid="ignore", divide="ignore"):
-        tcpa_s = np.where(moving, -(p_n * v_n + p_e * v_e) / np.where(moving, speed_sq, 1.0), 0.0)
-    tcpa_s = np.where(np.isnan(speed_sq), np.nan, tcpa_s)
-    cpa_m = np.hypot(p_n + v_n * tcpa_s, p_e + v_e * tcpa_s)
+    rel_position = np.stack(np.broadcast_arrays(rel_north_m, rel_east_m), axis=-1).astype(float)
+    rel_velocity = np.stack(np.broadcast_arrays(rel_vn_mps, rel_ve_mps), axis=-1).astype(float)
+    _, cpa_m, tcpa_s = cpa_tcpa_vectors(rel_position, rel_velocity)
     return cpa_m, tcpa_s
+
+
+def cpa_tcpa_vectors(
+    rel_position_m: NDArray[np.float64], rel_velocity_mps: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """(range, CPA, TCPA) from relative positions and velocities of any dimension (last axis).
+
+    The same formulas as ``cpa_tcpa``; used on Earth-centred 3-D vectors.
+    """
+    speed_sq = np.sum(rel_velocity_mps * rel_velocity_mps, axis=-1)
+    moving = speed_sq >= _STILL_MPS * _STILL_MPS
+    dot = np.sum(rel_position_m * rel_velocity_mps, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tcpa_s = np.where(moving, -dot / np.where(moving, speed_sq, 1.0), 0.0)
+    tcpa_s = np.where(np.isnan(speed_sq), np.nan, tcpa_s)
+    closest = rel_position_m + rel_velocity_mps * tcpa_s[..., None]
+    return (
+        np.linalg.norm(rel_position_m, axis=-1),
+        np.linalg.norm(closest, axis=-1),
+        tcpa_s,
+    )
 
 
 def trigger_mask(
@@ -65,7 +87,7 @@ def trigger_mask(
 ) -> NDArray[np.bool_]:
     """The paper's trigger ``0 <= TCPA <= tcpa_act_s and CPA < cpa_req_m``.
 
-    A pair with no relative motion (relative speed < 1 µm/s, e.g. parallel courses at equal
+    A pair with no relative motion (relative speed < 1 cm/s, e.g. parallel courses at equal
     speed) never triggers: nothing approaches, even if it sails within ``cpa_req_m``.
     """
     tcpa = np.asarray(tcpa_s, dtype=float)
@@ -136,31 +158,45 @@ def candidate_pairs(
     east_m: NDArray[np.float64],
     range_m: float,
 ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Index pairs (i, j), i ≠ j, of points at the same step within ``range_m`` (inclusive),
+    in a plane; see ``candidate_pairs_nd``."""
+    return candidate_pairs_nd(step, (north_m, east_m), range_m)
+
+
+def candidate_pairs_nd(
+    step: NDArray[np.int64],
+    coordinates: tuple[NDArray[np.float64], ...],
+    range_m: float,
+) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """Index pairs (i, j), i ≠ j, of points at the same step within ``range_m`` (inclusive).
 
-    Each unordered pair appears once. Points are hashed into square cells of side
-    ``range_m``; a point is compared with the points of its own cell and of four of its
-    eight neighbours (the other four see it from their side).
+    Each unordered pair appears once. Points are hashed into cells of side ``range_m`` in
+    as many dimensions as ``coordinates`` has; a point is compared with the points of its
+    own cell and of half of its neighbours (the other half see it from their side).
     """
     if len(step) == 0:
         empty = np.zeros(0, dtype=np.intp)
         return empty, empty
-    cell_n = np.floor(north_m / range_m).astype(np.int64)
-    cell_e = np.floor(east_m / range_m).astype(np.int64)
-    cell_n -= cell_n.min() - 1
-    cell_e -= cell_e.min() - 1
-    height = int(cell_e.max()) + 2
-    width = int(cell_n.max()) + 2
-    key = ((step - step.min()) * width + cell_n) * height + cell_e
+    cells = []
+    for values in coordinates:
+        cell = np.floor(values / range_m).astype(np.int64)
+        cells.append(cell - (cell.min() - 1))
+    sizes = [int(cell.max()) + 2 for cell in cells]
+    key = step - step.min()
+    for cell, size in zip(cells, sizes, strict=True):
+        key = key * size + cell
+    strides = [int(np.prod(sizes[i + 1 :], dtype=np.int64)) for i in range(len(sizes))]
     order = np.argsort(key, kind="stable")
     sorted_key = key[order]
     firsts: list[NDArray[np.intp]] = []
     seconds: list[NDArray[np.intp]] = []
-    for d_n, d_e in ((0, 0), (0, 1), (1, -1), (1, 0), (1, 1)):
-        wanted = sorted_key + d_n * height + d_e
+    for offset in itertools.product((-1, 0, 1), repeat=len(cells)):
+        if offset < (0,) * len(cells):
+            continue  # the mirrored neighbour finds this pair
+        wanted = sorted_key + sum(o * stride for o, stride in zip(offset, strides, strict=True))
         lo = np.searchsorted(sorted_key, wanted, side="left")
         hi = np.searchsorted(sorted_key, wanted, side="right")
-        if d_n == 0 and d_e == 0:
+        if not any(offset):
             lo = np.arange(len(sorted_key)) + 1  # the same cell: only later points
         counts = np.maximum(hi - lo, 0)
         total = int(counts.sum())
@@ -176,7 +212,8 @@ def candidate_pairs(
         return empty, empty
     first = np.concatenate(firsts)
     second = np.concatenate(seconds)
-    near = np.hypot(north_m[first] - north_m[second], east_m[first] - east_m[second]) <= range_m
+    distance_sq = sum((values[first] - values[second]) ** 2 for values in coordinates)
+    near = distance_sq <= range_m * range_m
     return first[near], second[near]
 
 
@@ -205,10 +242,11 @@ def find_encounters(
     step = samples["step"].to_numpy()[rows]
     by_step = np.argsort(step, kind="stable")
     rows, step = rows[by_step], step[by_step]
-    north = samples["north_m"].to_numpy()[rows]
-    east = samples["east_m"].to_numpy()[rows]
-    v_n, v_e = velocity_mps(
-        samples["speed_mps"].to_numpy()[rows], samples["cog_grid_deg"].to_numpy()[rows]
+    lat = samples["lat_deg"].to_numpy()[rows]
+    lon = samples["lon_deg"].to_numpy()[rows]
+    position = ecef_m(lat, lon)
+    velocity = velocity_ecef_mps(
+        lat, lon, samples["speed_mps"].to_numpy()[rows], samples["cog_deg"].to_numpy()[rows]
     )
     vessel_ids, vessel = np.unique(samples["mmsi"].to_numpy()[rows], return_inverse=True)
 
@@ -224,10 +262,10 @@ def find_encounters(
             if hi <= lo:
                 continue
             part = slice(lo, hi)
-            i, j = candidate_pairs(step[part], north[part], east[part], params.candidate_range_m)
+            i, j = candidate_pairs_nd(step[part], tuple(position[part].T), params.candidate_range_m)
             i, j = i + lo, j + lo
             pair_steps += len(i)
-            runs.append(_batch_runs(i, j, step, vessel, north, east, v_n, v_e, params))
+            runs.append(_batch_runs(i, j, step, vessel, position, velocity, params))
     return EncounterSearch(
         encounters=_encounters(_join_runs(runs), vessel_ids, own, tracks),
         candidate_pair_steps=pair_steps,
@@ -239,10 +277,8 @@ def _batch_runs(
     j: NDArray[np.intp],
     step: NDArray[np.int64],
     vessel: NDArray[np.intp],
-    north: NDArray[np.float64],
-    east: NDArray[np.float64],
-    v_n: NDArray[np.float64],
-    v_e: NDArray[np.float64],
+    position: NDArray[np.float64],
+    velocity: NDArray[np.float64],
     params: ReplayParams,
 ) -> pd.DataFrame:
     """Runs of consecutive candidate steps per pair within one batch of steps."""
@@ -254,20 +290,19 @@ def _batch_runs(
     pair_code = vessel[a].astype(np.int64) * (int(vessel.max()) + 1) + vessel[b]
     order = np.argsort(pair_code * batch_steps + (step[a] - step[a].min(initial=0)), kind="stable")
     a, b = a[order], b[order]
-    cpa_m, tcpa_s = cpa_tcpa(
-        north[b] - north[a], east[b] - east[a], v_n[b] - v_n[a], v_e[b] - v_e[a]
-    )
+    rel_velocity = velocity[b] - velocity[a]
+    range_m, cpa_m, tcpa_s = cpa_tcpa_vectors(position[b] - position[a], rel_velocity)
     frame = pd.DataFrame(
         {
             "vessel_a": vessel[a],
             "vessel_b": vessel[b],
             "step": step[a],
-            "range_m": np.hypot(north[b] - north[a], east[b] - east[a]),
+            "range_m": range_m,
             "cpa_m": cpa_m,
             "tcpa_s": tcpa_s,
         }
     )
-    rel_speed_mps = np.hypot(v_n[b] - v_n[a], v_e[b] - v_e[a])
+    rel_speed_mps = np.linalg.norm(rel_velocity, axis=-1)
     fires = trigger_mask(cpa_m, tcpa_s, rel_speed_mps, params)
     return _runs(frame, pd.Series(fires, index=frame.index))
 
@@ -395,14 +430,16 @@ def encounter_series(
     series.insert(
         1, "timestamp", pd.to_datetime(series["step"] * tracks.step_s, unit="s", utc=True)
     )
-    own_vn, own_ve = velocity_mps(series["own_speed_mps"], series["own_cog_grid_deg"])
-    tgt_vn, tgt_ve = velocity_mps(series["target_speed_mps"], series["target_cog_grid_deg"])
-    series["rel_north_m"] = series["target_north_m"] - series["own_north_m"]
-    series["rel_east_m"] = series["target_east_m"] - series["own_east_m"]
-    series["range_m"] = np.hypot(series["rel_north_m"], series["rel_east_m"])
-    cpa_m, tcpa_s = cpa_tcpa(
-        series["rel_north_m"], series["rel_east_m"], tgt_vn - own_vn, tgt_ve - own_ve
-    )
+    own_lat, own_lon = series["own_lat_deg"].to_numpy(), series["own_lon_deg"].to_numpy()
+    tgt_lat, tgt_lon = series["target_lat_deg"].to_numpy(), series["target_lon_deg"].to_numpy()
+    rel_position = ecef_m(tgt_lat, tgt_lon) - ecef_m(own_lat, own_lon)
+    rel_velocity = velocity_ecef_mps(
+        tgt_lat, tgt_lon, series["target_speed_mps"], series["target_cog_deg"]
+    ) - velocity_ecef_mps(own_lat, own_lon, series["own_speed_mps"], series["own_cog_deg"])
+    # the target's offset in own ship's tangent plane (true north, east)
+    series["rel_north_m"], series["rel_east_m"] = in_tangent_plane(rel_position, own_lat, own_lon)
+    range_m, cpa_m, tcpa_s = cpa_tcpa_vectors(rel_position, rel_velocity)
+    series["range_m"] = range_m
     series["cpa_m"] = cpa_m
     series["tcpa_s"] = tcpa_s
     return series.reset_index(drop=True)

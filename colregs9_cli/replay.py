@@ -376,16 +376,19 @@ def run_params(
 
 
 def run_frame(query: Query, positions: pd.DataFrame) -> LocalFrame:
-    """The query region's frame, or one centred on the data's extent when there is none."""
+    """The query region's frame, or one centred on the data when there is none.
+
+    The frame carries the chart, the manoeuvrability estimate and the figures; the geometry
+    between vessels never uses it (``encounters.py``). Its central meridian is the circular
+    mean of the longitudes, so that data across the antimeridian is centred on it.
+    """
     frame = query.frame()
     if frame is not None:
         return frame
-    return LocalFrame.centred_on(
-        float(positions["lat_deg"].min()),
-        float(positions["lat_deg"].max()),
-        float(positions["lon_deg"].min()),
-        float(positions["lon_deg"].max()),
-    )
+    lon_rad = np.radians(positions["lon_deg"].to_numpy(dtype=float))
+    lon0 = float(np.degrees(np.arctan2(np.sin(lon_rad).mean(), np.cos(lon_rad).mean())))
+    lat = positions["lat_deg"]
+    return LocalFrame((float(lat.min()) + float(lat.max())) / 2.0, lon0)
 
 
 def _ledger_with_tracks(ledger: RejectsLedger, tracks: Tracks) -> RejectsLedger:
@@ -511,11 +514,7 @@ def _pair_steps(
     step_s: float,
 ) -> _PairSteps:
     """G_a, the estimates and G_d of both seats at every step of ``series`` (a = own_)."""
-    g_a = evaluate_colregs(
-        Kinematics.from_frame(series, "own_"),
-        Kinematics.from_frame(series, "target_"),
-        params.colregs,
-    )
+    g_a = evaluate_colregs(*Kinematics.pair_from_series(series), params.colregs)
     rows = len(series)
     held = ColregsEvaluation(
         **{

@@ -46,7 +46,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from .geo import LocalFrame
+from .geo import LocalFrame, ecef_m, true_bearing_deg
 from .replay_params import CourseSource, ReplayParams
 from .units import MPS_PER_KNOT, signed_angle_deg, wrap_deg
 
@@ -158,12 +158,15 @@ def build_tracks(
 
     report_lat = positions["lat_deg"].to_numpy(dtype=float)[order]
     report_lon = positions["lon_deg"].to_numpy(dtype=float)[order]
-    north, east = frame.to_local(report_lat, report_lon)
-    keep, jump_split = _drop_jumps(mmsi, t, north, east, params)
+    # Distances between reports are measured on the Earth, not in the map frame, whose
+    # scale grows away from its centre (a satellite feed's frame passes 2).
+    where = ecef_m(report_lat, report_lon)
+    keep, jump_split = _drop_jumps(mmsi, t, where, params)
     speed_jump_dropped = int((~keep).sum())
-    order, mmsi, t, north, east = order[keep], mmsi[keep], t[keep], north[keep], east[keep]
+    order, mmsi, t, where = order[keep], mmsi[keep], t[keep], where[keep]
     report_lat, report_lon = report_lat[keep], report_lon[keep]
     jump_split = jump_split[keep]
+    north, east = frame.to_local(report_lat, report_lon)
 
     first_of_vessel = np.ones(len(t), dtype=bool)
     first_of_vessel[1:] = mmsi[1:] != mmsi[:-1]
@@ -177,13 +180,7 @@ def build_tracks(
         return pd.to_numeric(positions[name], errors="coerce").to_numpy(dtype=float)[order]
 
     sog_kn, cog_deg = _fill_motion(
-        segment_of_report,
-        t,
-        north,
-        east,
-        frame.grid_convergence_deg(report_lat, report_lon),
-        column("sog_kn"),
-        column("cog_deg"),
+        segment_of_report, t, report_lat, report_lon, column("sog_kn"), column("cog_deg")
     )
     heading_deg = column("heading_deg")
     heading_deg = np.where(np.isnan(heading_deg), cog_deg, heading_deg)
@@ -235,17 +232,20 @@ def _epoch_seconds(timestamps: pd.Series) -> NDArray[np.float64]:
 def _drop_jumps(
     mmsi: NDArray[np.int64],
     t: NDArray[np.float64],
-    north: NDArray[np.float64],
-    east: NDArray[np.float64],
+    where: NDArray[np.float64],
     params: ReplayParams,
 ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-    """(keep, split) masks for rule 2. Only vessels with a consecutive jump are walked."""
+    """(keep, split) masks for rule 2. Only vessels with a consecutive jump are walked.
+
+    ``where`` holds the reports' Earth-centred positions (``geo.ecef_m``); distances are the
+    chords between them, the geodesic distance to 1 mm in 10 km.
+    """
     keep = np.ones(len(t), dtype=bool)
     split = np.zeros(len(t), dtype=bool)
     max_speed_mps = params.max_speed_kn * MPS_PER_KNOT
     same = mmsi[1:] == mmsi[:-1]
     dt = t[1:] - t[:-1]
-    implied = np.hypot(np.diff(north), np.diff(east)) / np.where(dt > 0, dt, np.inf)
+    implied = np.linalg.norm(np.diff(where, axis=0), axis=-1) / np.where(dt > 0, dt, np.inf)
     jumps = same & (dt <= params.max_gap_s) & (implied > max_speed_mps)
     if not jumps.any():
         return keep, split
@@ -255,8 +255,7 @@ def _drop_jumps(
     for start, end in zip(starts[vessel_has_jump], ends[vessel_has_jump], strict=True):
         _walk_jumps(
             t[start:end],
-            north[start:end],
-            east[start:end],
+            where[start:end],
             params.max_gap_s,
             max_speed_mps,
             keep[start:end],
@@ -267,8 +266,7 @@ def _drop_jumps(
 
 def _walk_jumps(
     t: NDArray[np.float64],
-    north: NDArray[np.float64],
-    east: NDArray[np.float64],
+    where: NDArray[np.float64],
     max_gap_s: float,
     max_speed_mps: float,
     keep: NDArray[np.bool_],
@@ -278,9 +276,7 @@ def _walk_jumps(
 
     def plausible(i: int, j: int) -> bool:
         dt = t[j] - t[i]
-        return dt > max_gap_s or np.hypot(north[j] - north[i], east[j] - east[i]) <= (
-            max_speed_mps * dt
-        )
+        return dt > max_gap_s or float(np.linalg.norm(where[j] - where[i])) <= (max_speed_mps * dt)
 
     anchor = 0
     for i in range(1, len(t)):
@@ -304,28 +300,28 @@ def _walk_jumps(
 def _fill_motion(
     segment: NDArray[np.int64],
     t: NDArray[np.float64],
-    north: NDArray[np.float64],
-    east: NDArray[np.float64],
-    convergence_deg: NDArray[np.float64],
+    lat_deg: NDArray[np.float64],
+    lon_deg: NDArray[np.float64],
     sog_kn: NDArray[np.float64],
     cog_deg: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Rule 4: null SOG/COG from the movement between the report's neighbours.
 
-    The movement's direction is a grid bearing; ``convergence_deg`` (γ at each report) turns
-    it to true like the reported COGs.
+    The movement is measured on the Earth: its length as the chord between the two
+    positions, its direction as the true bearing at the earlier one.
     """
     index = np.arange(len(t))
     previous = np.where(np.r_[False, segment[1:] == segment[:-1]], index - 1, index)
     following = np.where(np.r_[segment[:-1] == segment[1:], False], index + 1, index)
-    d_north = north[following] - north[previous]
-    d_east = east[following] - east[previous]
+    where = ecef_m(lat_deg, lon_deg)
+    distance = np.linalg.norm(where[following] - where[previous], axis=-1)
     dt = t[following] - t[previous]
-    distance = np.hypot(d_north, d_east)
     with np.errstate(invalid="ignore", divide="ignore"):
         derived_sog = np.where(dt > 0, distance / dt / MPS_PER_KNOT, np.nan)
-    grid_cog = np.degrees(np.arctan2(d_east, d_north))
-    derived_cog = np.where(distance > 0, wrap_deg(grid_cog + convergence_deg), np.nan)
+    bearing = true_bearing_deg(
+        lat_deg[previous], lon_deg[previous], lat_deg[following], lon_deg[following]
+    )
+    derived_cog = np.where(distance > 0, bearing, np.nan)
     return (
         np.where(np.isnan(sog_kn), derived_sog, sog_kn),
         np.where(np.isnan(cog_deg), derived_cog, cog_deg),

@@ -209,11 +209,18 @@ def test_missing_sog_and_cog_come_from_the_movement() -> None:
     assert samples.loc[T0_S + 10, "sog_kn"] == pytest.approx(5.0 / MPS_PER_KNOT)
     assert samples.loc[T0_S + 20, "sog_kn"] == pytest.approx(2.75 / MPS_PER_KNOT)
     assert samples.loc[T0_S + 30, "sog_kn"] == pytest.approx(0.5 / MPS_PER_KNOT)
-    # Due grid east; the true COG adds the meridian convergence at the sample (1.4e-3° 100 m
-    # east of this frame's central meridian, hence the tolerance of the true check).
-    assert samples["cog_grid_deg"].to_numpy() == pytest.approx(90.0, abs=1e-9)
-    convergence_deg = FRAME.grid_convergence_deg(samples["lat_deg"], samples["lon_deg"])
-    assert samples["cog_deg"].to_numpy() == pytest.approx(90.0 + convergence_deg, abs=1e-9)
+    # The derived COG is the true bearing of the movement, measured on the Earth; checked
+    # against pyproj's geodesic azimuth from the earlier report to the later one (due grid
+    # east here, 1.4e-3° off true east 100 m east of this frame's central meridian).
+    from pyproj import Geod
+
+    lat, lon = frame["lat_deg"].to_numpy(), frame["lon_deg"].to_numpy()
+    azimuth, _, _ = Geod(ellps="WGS84").inv(
+        lon[[0, 0, 1, 2]], lat[[0, 0, 1, 2]], lon[[1, 2, 3, 3]], lat[[1, 2, 3, 3]]
+    )
+    by_report = samples.loc[[T0_S + 0, T0_S + 10, T0_S + 20, T0_S + 30], "cog_deg"].to_numpy()
+    assert by_report == pytest.approx(azimuth % 360.0, abs=1e-5)
+    assert samples["cog_grid_deg"].to_numpy() == pytest.approx(90.0, abs=1e-3)
     assert samples["cog_deg"].to_numpy() == pytest.approx(90.0, abs=2e-3)
 
 
