@@ -131,6 +131,13 @@ def replay_command(
         float | None,
         typer.Option("--alpha", metavar="A", help="Scale α of the rate of swing, in [0, 1]; 0.4."),
     ] = None,
+    overwrite: Annotated[
+        bool,
+        typer.Option(
+            "--overwrite",
+            help="Replace an --out directory that holds something other than a colregs9 report.",
+        ),
+    ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
     """Replay AIS encounter by encounter through COLREGs rules 13–15 and the rule 9 automaton.
@@ -162,6 +169,7 @@ def replay_command(
             },
             fmt=fmt,
             quiet=quiet,
+            overwrite=overwrite,
         )
     typer.echo(result.text, nl=False)
     typer.echo(f"Reports in {result.out_dir}")
@@ -246,6 +254,13 @@ def stats_command(
             "--out", metavar="DIR", help="Output directory. Default: reports/stats-<query name>/."
         ),
     ] = None,
+    overwrite: Annotated[
+        bool,
+        typer.Option(
+            "--overwrite",
+            help="Replace an --out directory that holds something other than a colregs9 report.",
+        ),
+    ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bar.")] = False,
 ) -> None:
     """Vessel dimension statistics (length, breadth, draught), like the paper's table.
@@ -259,7 +274,16 @@ def stats_command(
     from .stats import run_stats
 
     with _user_errors():
-        result = run_stats(ais, query_path=query, per=per, by=by, fmt=fmt, out_dir=out, quiet=quiet)
+        result = run_stats(
+            ais,
+            query_path=query,
+            per=per,
+            by=by,
+            fmt=fmt,
+            out_dir=out,
+            quiet=quiet,
+            overwrite=overwrite,
+        )
     typer.echo(result.text, nl=False)
     if not quiet:
         typer.echo(f"Reports in {result.out_dir}", err=True)

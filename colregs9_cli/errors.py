@@ -36,6 +36,12 @@ class ChartError(Colregs9Error):
     exit_code = 2
 
 
+class OutputError(Colregs9Error):
+    """The output location cannot take the report (a file, a foreign directory, no access)."""
+
+    exit_code = 2
+
+
 class NoDataError(Colregs9Error):
     """The input is valid but the query selects nothing to work on."""
 

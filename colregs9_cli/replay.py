@@ -77,6 +77,7 @@ from .manoeuvrability import (
 from .progress import progress_bar, progress_enabled
 from .query import Query, everything_query, load_query
 from .replay_params import ReplayParams, replay_params_from_table
+from .report.atomic import check_out_dir
 from .report.manifest import inputs_manifest, jsonable, query_manifest, run_header
 from .report.replay_report import format_summary, write_replay_reports
 from .rule9 import DecidingRule, Finding, PairVerdict, decide_pair, nav_status_finding
@@ -1031,6 +1032,7 @@ def run_replay(
     overrides: dict[str, dict[str, Any]] | None = None,
     fmt: str | None = None,
     quiet: bool = True,
+    overwrite: bool = False,
 ) -> ReplayResult:
     """Replay ``ais_paths`` and write the reports (see the module docstring).
 
@@ -1040,6 +1042,8 @@ def run_replay(
     """
     query = load_query(query_path) if query_path is not None else everything_query()
     params = run_params(query, own_mmsi, overrides)
+    target = out_dir if out_dir is not None else default_out_dir(query.name)
+    check_out_dir(target, overwrite)
     data = load_ais(ais_paths, query=query, fmt=fmt, quiet=quiet)
     positions = data.positions
     vessels_in_data = positions["mmsi"].nunique()
@@ -1064,7 +1068,6 @@ def run_replay(
             outcomes.append(evaluate_pair(tracks, encounter, seats, chart, params))
             bar.advance()
     counts = _counts(tracks, search)
-    target = out_dir if out_dir is not None else default_out_dir(query.name)
     manifest = build_manifest(
         query, data, ledger, chart_paths, frame, params, tracks, counts, tuple(outcomes)
     )

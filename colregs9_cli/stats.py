@@ -55,6 +55,7 @@ def run_stats(
     fmt: str | None = None,
     out_dir: Path | None = None,
     quiet: bool = True,
+    overwrite: bool = False,
 ) -> StatsRun:
     """Read ``paths`` through the query, compute the statistics and write the reports.
 
@@ -65,6 +66,10 @@ def run_stats(
         from .query import everything_query, load_query
 
         query = load_query(query_path) if query_path is not None else everything_query()
+        from .report.atomic import check_out_dir
+
+        target = out_dir if out_dir is not None else default_out_dir(query.name)
+        check_out_dir(target, overwrite)
         from .ais.load import load_ais
         from .dimensions import GroupBy, Per, dimension_stats
         from .report.stats_report import build_manifest, format_text, write_stats_reports
@@ -73,7 +78,6 @@ def run_stats(
         by = None if by is None else _choice(GroupBy, by, "--by")
         data = load_ais(paths, query=query, fmt=fmt, quiet=quiet, started=started)
     result = dimension_stats(data.positions, data.dimension_reports, per=per, by=by)
-    target = out_dir if out_dir is not None else default_out_dir(query.name)
     manifest = build_manifest(result, query, data)
     files = write_stats_reports(target, result, query.name, manifest)
     return StatsRun(

@@ -7,7 +7,8 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
+import secrets
+import shutil
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -15,20 +16,127 @@ from typing import IO, Any
 
 import pandas as pd
 
+from ..errors import OutputError
+
 
 @contextmanager
 def atomic_path(target: Path) -> Iterator[Path]:
-    """Yield a temporary path in the target's directory; rename it to ``target`` on success."""
+    """Yield a temporary path in the target's directory; rename it to ``target`` on success.
+
+    The temporary file is created with mode 0666 less the umask, as ``open`` would create
+    the target itself (``tempfile.mkstemp`` would make it 0600 whatever the umask).
+    """
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(fd)
-    tmp = Path(tmp_name)
+    tmp = _new_file(target.parent, f".{target.name}.", ".tmp")
     try:
         yield tmp
         os.replace(tmp, target)
     finally:
         if tmp.exists():
             tmp.unlink()
+
+
+def _new_file(directory: Path, prefix: str, suffix: str) -> Path:
+    """An empty file of a fresh name, created exclusively, with the umask's mode."""
+    while True:
+        candidate = directory / f"{prefix}{secrets.token_hex(6)}{suffix}"
+        try:
+            fd = os.open(candidate, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666)
+        except FileExistsError:
+            continue
+        os.close(fd)
+        return candidate
+
+
+REPORT_MARKER = "run.json"
+
+
+def is_report(directory: Path) -> bool:
+    """True for a directory holding a colregs9 report (its run.json says so)."""
+    try:
+        manifest = json.loads((directory / REPORT_MARKER).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(manifest, dict) and manifest.get("tool") == "colregs9"
+
+
+def check_out_dir(out_dir: Path, overwrite: bool = False) -> None:
+    """Refuse, before any work, an ``--out`` that cannot take a report: a file, a directory
+    under a file, one without write access, the current, a parent or the home directory
+    (the report replaces its directory whole), or a directory holding something other than
+    a colregs9 report (unless ``overwrite``: its content is then replaced)."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise OutputError(f"{out_dir}: --out is a file, not a directory; give a directory")
+    existing = out_dir
+    while not existing.exists():
+        existing = existing.parent
+    if not existing.is_dir():
+        raise OutputError(
+            f"{out_dir}: --out lies under {existing}, which is a file; give a directory"
+        )
+    # The report replaces out_dir from beside it: its parent must be writable.
+    writable_in = out_dir.parent if existing == out_dir else existing
+    if not os.access(writable_in, os.W_OK | os.X_OK):
+        raise OutputError(
+            f"{out_dir}: no permission to write in {writable_in}; give a directory you can write to"
+        )
+    resolved = out_dir.resolve()
+    if resolved in (Path.cwd().resolve(), *Path.cwd().resolve().parents, Path.home().resolve()):
+        raise OutputError(
+            f"{out_dir}: --out would replace the current, a parent or the home directory; "
+            "give a directory of its own for the report"
+        )
+    if out_dir.is_dir() and any(out_dir.iterdir()) and not is_report(out_dir) and not overwrite:
+        raise OutputError(
+            f"{out_dir}: --out holds files that are not a colregs9 report; give a new or empty "
+            "directory, or add --overwrite to replace it"
+        )
+
+
+@contextmanager
+def report_directory(out_dir: Path) -> Iterator[Path]:
+    """Yield an empty staging directory beside ``out_dir``; on success it replaces
+    ``out_dir`` whole, so that a report is never a mix of two runs (no stale files of an
+    earlier run remain). On failure ``out_dir`` is left as it was, and an ``OSError`` while
+    writing becomes one ``OutputError``."""
+    try:
+        out_dir.parent.mkdir(parents=True, exist_ok=True)
+        staging = _new_directory(out_dir.parent, f".{out_dir.name}.", ".new")
+    except OSError as exc:
+        raise _output_error(out_dir, exc) from None
+    try:
+        yield staging
+        if out_dir.exists():
+            retired = out_dir.parent / f".{out_dir.name}.{secrets.token_hex(6)}.old"
+            os.replace(out_dir, retired)
+            os.replace(staging, out_dir)
+            shutil.rmtree(retired)
+        else:
+            os.replace(staging, out_dir)
+    except OSError as exc:
+        raise _output_error(out_dir, exc) from None
+    finally:
+        if staging.exists():
+            shutil.rmtree(staging, ignore_errors=True)
+
+
+def _output_error(out_dir: Path, exc: OSError) -> OutputError:
+    where = exc.filename if exc.filename else out_dir
+    return OutputError(
+        f"{out_dir}: cannot write the report ({exc.strerror or exc} at {where}); check the "
+        "free space and permissions, or give another --out"
+    )
+
+
+def _new_directory(parent: Path, prefix: str, suffix: str) -> Path:
+    """An empty directory of a fresh name, with the umask's mode (``mkdtemp`` makes 0700)."""
+    while True:
+        candidate = parent / f"{prefix}{secrets.token_hex(6)}{suffix}"
+        try:
+            os.mkdir(candidate, 0o777)
+        except FileExistsError:
+            continue
+        return candidate
 
 
 @contextmanager

@@ -24,7 +24,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .atomic import save_figure, write_csv, write_json, write_text
+from .atomic import report_directory, save_figure, write_csv, write_json, write_text
 from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart
 
 if TYPE_CHECKING:
@@ -436,8 +436,20 @@ def write_replay_reports(
     plots: bool,
     progress: ProgressSink,
 ) -> tuple[Path, ...]:
-    """Write every report file into ``result.out_dir``; returns the paths written."""
-    out_dir = result.out_dir
+    """Write every report file into ``result.out_dir``, which is replaced whole (no file of
+    an earlier run stays); returns the paths written."""
+    with report_directory(result.out_dir) as staging:
+        written = _write_replay_files(result, staging, chart, plots, progress)
+    return tuple(result.out_dir / path.relative_to(staging) for path in written)
+
+
+def _write_replay_files(
+    result: ReplayResult,
+    out_dir: Path,
+    chart: Chart | None,
+    plots: bool,
+    progress: ProgressSink,
+) -> tuple[Path, ...]:
     series_dir = out_dir / ENCOUNTER_DIR
     files: list[Path] = []
     for outcome in result.encounters:

@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from .atomic import save_figure, write_csv, write_json, write_text
+from .atomic import report_directory, save_figure, write_csv, write_json, write_text
 from .manifest import inputs_manifest, query_manifest, run_header
 
 if TYPE_CHECKING:
@@ -165,13 +165,13 @@ def build_manifest(result: StatsResult, query: Query, data: AisData) -> dict[str
 def write_stats_reports(
     out_dir: Path, result: StatsResult, query_name: str, manifest: dict[str, Any]
 ) -> tuple[Path, ...]:
-    """Write the four report files into ``out_dir``; returns their paths."""
-    csv_path = out_dir / CSV_NAME
-    markdown_path = out_dir / MARKDOWN_NAME
-    histogram_path = out_dir / HISTOGRAM_NAME
-    manifest_path = out_dir / MANIFEST_NAME
-    write_csv(csv_path, result.to_frame())
-    write_text(markdown_path, format_markdown(result, query_name))
-    save_figure(histogram_path, histogram_figure(result, query_name), dpi=110)
-    write_json(manifest_path, manifest)
-    return (csv_path, markdown_path, histogram_path, manifest_path)
+    """Write the four report files into ``out_dir``, which is replaced whole; returns their
+    paths."""
+    names = (CSV_NAME, MARKDOWN_NAME, HISTOGRAM_NAME, MANIFEST_NAME)
+    with report_directory(out_dir) as staging:
+        csv_path, markdown_path, histogram_path, manifest_path = (staging / n for n in names)
+        write_csv(csv_path, result.to_frame())
+        write_text(markdown_path, format_markdown(result, query_name))
+        save_figure(histogram_path, histogram_figure(result, query_name), dpi=110)
+        write_json(manifest_path, manifest)
+    return tuple(out_dir / name for name in names)

@@ -1,0 +1,118 @@
+"""Report directories: written whole or not at all, never mixed with an earlier run, modes
+from the umask, and a bad --out refused with one Error line before any work."""
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from colregs9_cli.cli import app
+from colregs9_cli.errors import OutputError
+from colregs9_cli.report.atomic import check_out_dir, report_directory, write_text
+
+from fixture_files import DMA26, NMEA
+
+
+def _mode(path: Path) -> int:
+    return stat.S_IMODE(path.stat().st_mode)
+
+
+@pytest.mark.parametrize(
+    ("umask", "file_mode", "dir_mode"), [(0o022, 0o644, 0o755), (0o077, 0o600, 0o700)]
+)
+def test_modes_follow_the_umask(tmp_path: Path, umask: int, file_mode: int, dir_mode: int) -> None:
+    previous = os.umask(umask)
+    try:
+        with report_directory(tmp_path / "report") as staging:
+            write_text(staging / "sub" / "a.txt", "x")
+        write_text(tmp_path / "single.txt", "y")
+    finally:
+        os.umask(previous)
+    assert _mode(tmp_path / "report") == dir_mode
+    assert _mode(tmp_path / "report" / "sub") == dir_mode
+    assert _mode(tmp_path / "report" / "sub" / "a.txt") == file_mode
+    assert _mode(tmp_path / "single.txt") == file_mode
+
+
+def _invoke(*args: str):
+    return CliRunner().invoke(app, list(args))
+
+
+def _one_error_line(output: str) -> str:
+    lines = [line for line in output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error: "), output
+    return lines[0]
+
+
+def test_a_rerun_leaves_no_stale_file(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    first = _invoke("replay", str(NMEA), "--no-plots", "--quiet", "--out", str(out))
+    assert first.exit_code == 0, first.output
+    before = {p.name for p in (out / "encounters").iterdir()}
+    stricter = _invoke(
+        "replay", str(NMEA), "--no-plots", "--quiet", "--out", str(out), "--cpa-req-m", "20"
+    )
+    assert stricter.exit_code == 0, stricter.output
+    after = {p.name for p in (out / "encounters").iterdir()}
+    assert after < before  # the encounters of the first run are gone, not left beside
+    listed = (out / "encounters.csv").read_text().count("\n") - 1
+    assert len(after) == listed
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no staging left
+
+
+def test_a_foreign_directory_is_refused_unless_overwrite(tmp_path: Path) -> None:
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "thesis.tex").write_text("precious")
+    refused = _invoke("stats", str(DMA26), "--quiet", "--out", str(out))
+    assert refused.exit_code == OutputError.exit_code
+    assert "not a colregs9 report" in _one_error_line(refused.output)
+    assert (out / "thesis.tex").read_text() == "precious"
+    replaced = _invoke("stats", str(DMA26), "--quiet", "--out", str(out), "--overwrite")
+    assert replaced.exit_code == 0, replaced.output
+    assert not (out / "thesis.tex").exists() and (out / "run.json").is_file()
+    # a colregs9 report is replaced without --overwrite
+    again = _invoke("stats", str(DMA26), "--quiet", "--out", str(out))
+    assert again.exit_code == 0, again.output
+
+
+@pytest.mark.parametrize("kind", ["file", "under-a-file", "current-directory"])
+def test_a_bad_out_is_one_error_before_any_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, kind: str
+) -> None:
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    out = {"file": a_file, "under-a-file": a_file / "report", "current-directory": Path(".")}[kind]
+    monkeypatch.chdir(tmp_path)
+    for command in (["replay", str(NMEA), "--no-plots"], ["stats", str(DMA26)]):
+        result = _invoke(*command, "--quiet", "--out", str(out))
+        assert result.exit_code == OutputError.exit_code, result.output
+        assert str(out) in _one_error_line(result.output)
+    assert a_file.read_text() == "x"
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root may write anywhere")
+def test_an_unwritable_parent_is_refused(tmp_path: Path) -> None:
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        with pytest.raises(OutputError, match="no permission"):
+            check_out_dir(locked / "report")
+    finally:
+        locked.chmod(0o700)
+
+
+def test_a_failed_run_leaves_the_old_report(tmp_path: Path) -> None:
+    out = tmp_path / "report"
+    with report_directory(out) as staging:
+        write_text(staging / "run.json", '{"tool": "colregs9"}')
+    with pytest.raises(RuntimeError), report_directory(out) as staging:
+        write_text(staging / "half.txt", "half")
+        raise RuntimeError("the analysis failed")
+    assert sorted(p.name for p in out.iterdir()) == ["run.json"]
+    assert [p.name for p in tmp_path.iterdir()] == ["report"]
