@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from pyproj import CRS, Proj, Transformer
+from pyproj import CRS, Geod, Proj, Transformer
 
 from .errors import ParameterError
 from .units import wrap_deg
@@ -185,3 +185,23 @@ def course_in_tangent_plane(
     direction = velocity_ecef_mps(lat_deg, lon_deg, 1.0, course_deg)
     d_north, d_east = in_tangent_plane(direction, plane_lat_deg, plane_lon_deg)
     return wrap_deg(np.degrees(np.arctan2(d_east, d_north)))
+
+
+_GEOD = Geod(ellps="WGS84")
+
+
+def sail(
+    lat_deg: ArrayLike, lon_deg: ArrayLike, course_deg: ArrayLike, distance_m: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Where a vessel is after ``distance_m`` along the geodesic starting on a true course
+    (NaN course or distance: NaN)."""
+    lat, lon, course, distance = np.broadcast_arrays(
+        *(np.asarray(v, dtype=float) for v in (lat_deg, lon_deg, course_deg, distance_m))
+    )
+    known = np.isfinite(lat) & np.isfinite(lon) & np.isfinite(course) & np.isfinite(distance)
+    out_lat = np.full(lat.shape, np.nan)
+    out_lon = np.full(lat.shape, np.nan)
+    if known.any():
+        lons, lats, _ = _GEOD.fwd(lon[known], lat[known], course[known], distance[known])
+        out_lat[known], out_lon[known] = lats, lons
+    return out_lat, out_lon

@@ -67,7 +67,7 @@ from .colregs import (
 )
 from .encounters import Encounter, EncounterSearch, encounter_series, find_encounters, velocity_mps
 from .errors import ChartError, NoDataError
-from .geo import LocalFrame
+from .geo import LocalFrame, sail
 from .manoeuvrability import (
     ManoeuvrabilityAssessment,
     ManoeuvrabilityParams,
@@ -105,6 +105,10 @@ class VesselAtTrigger:
     nav_status: int | None
     course_deg: float
     speed_kn: float
+    lat_deg: float
+    lon_deg: float
+    lat_deg_at_cpa: float  # predicted at constant velocity from the trigger to TCPA
+    lon_deg_at_cpa: float
     estimated_restricted: Restriction
     conduct: Conduct
     action_before_cpa_s: float | None
@@ -144,6 +148,14 @@ class PairSummary:
     range_m_at_trigger: float
     cpa_m: float
     tcpa_s: float
+    lat_deg_at_trigger_a: float
+    lon_deg_at_trigger_a: float
+    lat_deg_at_trigger_b: float
+    lon_deg_at_trigger_b: float
+    lat_deg_at_cpa_a: float
+    lon_deg_at_cpa_a: float
+    lat_deg_at_cpa_b: float
+    lon_deg_at_cpa_b: float
     data_covers_cpa: bool
     actual_min_separation_m: float | None
     actual_min_separation_utc: pd.Timestamp | None
@@ -208,6 +220,14 @@ class EncounterSummary:
     range_m_at_trigger: float
     cpa_m: float
     tcpa_s: float
+    own_lat_deg_at_trigger: float
+    own_lon_deg_at_trigger: float
+    target_lat_deg_at_trigger: float
+    target_lon_deg_at_trigger: float
+    own_lat_deg_at_cpa: float
+    own_lon_deg_at_cpa: float
+    target_lat_deg_at_cpa: float
+    target_lon_deg_at_cpa: float
     data_covers_cpa: bool
     actual_min_separation_m: float | None
     actual_min_separation_utc: pd.Timestamp | None
@@ -663,6 +683,15 @@ def evaluate_pair(
         for m in (a, b)
     )
     trigger = series.iloc[0]
+    at_cpa = {
+        prefix: sail(
+            trigger[f"{prefix}lat_deg"],
+            trigger[f"{prefix}lon_deg"],
+            trigger[f"{prefix}cog_deg"],
+            trigger[f"{prefix}speed_mps"] * trigger["tcpa_s"],
+        )
+        for prefix in ("own_", "target_")
+    }
     vessels = tuple(
         VesselAtTrigger(
             mmsi=mmsi,
@@ -671,6 +700,10 @@ def evaluate_pair(
             nav_status=_nav_status(trigger[f"{prefix}nav_status"]),
             course_deg=float(trigger[f"{prefix}course_deg"]),
             speed_kn=float(trigger[f"{prefix}sog_kn"]),
+            lat_deg=float(trigger[f"{prefix}lat_deg"]),
+            lon_deg=float(trigger[f"{prefix}lon_deg"]),
+            lat_deg_at_cpa=float(at_cpa[prefix][0]),
+            lon_deg_at_cpa=float(at_cpa[prefix][1]),
             estimated_restricted=steps.estimates[i][0],
             conduct=audit.conducts[i],
             action_before_cpa_s=audit.before_cpa_s[i],
@@ -742,6 +775,14 @@ def _pair_summary(
         range_m_at_trigger=float(trigger["range_m"]),
         cpa_m=float(trigger["cpa_m"]),
         tcpa_s=float(trigger["tcpa_s"]),
+        lat_deg_at_trigger_a=a.lat_deg,
+        lon_deg_at_trigger_a=a.lon_deg,
+        lat_deg_at_trigger_b=b.lat_deg,
+        lon_deg_at_trigger_b=b.lon_deg,
+        lat_deg_at_cpa_a=a.lat_deg_at_cpa,
+        lon_deg_at_cpa_a=a.lon_deg_at_cpa,
+        lat_deg_at_cpa_b=b.lat_deg_at_cpa,
+        lon_deg_at_cpa_b=b.lon_deg_at_cpa,
         data_covers_cpa=audit.covers_cpa,
         actual_min_separation_m=audit.min_separation_m,
         actual_min_separation_utc=audit.cpa_utc,
@@ -895,6 +936,14 @@ def _seat_outcome(
         range_m_at_trigger=pair.range_m_at_trigger,
         cpa_m=pair.cpa_m,
         tcpa_s=pair.tcpa_s,
+        own_lat_deg_at_trigger=own.lat_deg,
+        own_lon_deg_at_trigger=own.lon_deg,
+        target_lat_deg_at_trigger=target.lat_deg,
+        target_lon_deg_at_trigger=target.lon_deg,
+        own_lat_deg_at_cpa=own.lat_deg_at_cpa,
+        own_lon_deg_at_cpa=own.lon_deg_at_cpa,
+        target_lat_deg_at_cpa=target.lat_deg_at_cpa,
+        target_lon_deg_at_cpa=target.lon_deg_at_cpa,
         data_covers_cpa=pair.data_covers_cpa,
         actual_min_separation_m=pair.actual_min_separation_m,
         actual_min_separation_utc=pair.actual_min_separation_utc,

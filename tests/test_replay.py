@@ -555,3 +555,24 @@ def test_policies_and_swing_models_through_a_replay_on_a_chart(
     )
     assert own.summary.automaton_path == expected_path
     assert_seats_agree(_encounters(result))
+
+
+def test_positions_at_the_trigger_and_at_cpa(national) -> None:
+    table = _encounters(national)
+    _, _, apart_m = GEOD.inv(
+        table["own_lon_deg_at_cpa"],
+        table["own_lat_deg_at_cpa"],
+        table["target_lon_deg_at_cpa"],
+        table["target_lat_deg_at_cpa"],
+    )
+    # the predicted positions at TCPA are the CPA apart
+    np.testing.assert_allclose(apart_m, table["cpa_m"], atol=1.0, rtol=0.002)
+    _, _, range_m = GEOD.inv(
+        table["own_lon_deg_at_trigger"],
+        table["own_lat_deg_at_trigger"],
+        table["target_lon_deg_at_trigger"],
+        table["target_lat_deg_at_trigger"],
+    )
+    np.testing.assert_allclose(range_m, table["range_m_at_trigger"], atol=1e-3)
+    pairs = _pairs(national).astype({"lat_deg_at_cpa_a": float, "cpa_m": float})
+    assert pairs["lat_deg_at_cpa_a"].between(54.0, 58.5).all()
