@@ -140,10 +140,11 @@ def replay_command(
     ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
-    """Replay AIS encounter by encounter through COLREGs rules 13–15 and the rule 9 automaton.
+    """Replay AIS pair by pair through COLREGs rules 13–15 and the rule 9 automaton.
 
-    Writes encounters.csv, encounters/<id>.csv and .png, index.md and run.json, and prints a
-    summary of the triggered encounters. Without --chart, manoeuvrability is "unknown".
+    Writes pairs.csv (one verdict per pair, the same from both seats), encounters.csv (one row
+    per seat), encounters/<id>.csv and .png, index.md and run.json, and prints one line per
+    triggered pair. Without --chart, manoeuvrability is "unknown".
 
     Example: colregs9 replay fixtures/ais/dma_nmea_2013-11-12_5min.txt.gz --no-plots
     """

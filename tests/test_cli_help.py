@@ -43,3 +43,20 @@ def test_readme_documents_every_command_and_its_options(name: str) -> None:
     body = section[1].split("\n### ", 1)[0]
     missing = sorted(o for o in options if o not in body)
     assert not missing, f"README section for {name} does not mention {missing}"
+
+
+def test_python_dash_m_runs_the_cli() -> None:
+    import subprocess
+    import sys
+
+    from colregs9_cli import __version__
+
+    done = subprocess.run(
+        [sys.executable, "-m", "colregs9_cli", "--version"],
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == f"colregs9 {__version__}"

@@ -1,0 +1,5 @@
+"""``python -m colregs9_cli``: the same as the ``colregs9`` console script."""
+
+from .cli import run
+
+run()
