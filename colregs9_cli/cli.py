@@ -199,7 +199,7 @@ def simulate_command(
     Checks that every route lies in water navigable for that vessel's draught on the
     scenario's chart, then writes one report per vessel every ais_interval_s.
 
-    Example: colregs9 simulate fixtures/scenarios/greenhopper_restricted.toml
+    Example: colregs9 simulate colregs9_cli/data/demo/greenhopper_restricted.toml
     """
     from .simulate import simulate_scenario
 
@@ -361,35 +361,48 @@ def demo_command(
         typer.Option("--out", metavar="DIR", help="Output directory. Default: reports/demo/."),
     ] = None,
     scenarios: Annotated[
-        Path,
+        Path | None,
         typer.Option(
             "--scenarios",
             metavar="DIR",
-            help="Directory with greenhopper_restricted.toml and greenhopper_not_restricted.toml.",
+            help="Directory with greenhopper_restricted.toml and greenhopper_not_restricted.toml."
+            " Default: the package's own (colregs9_cli/data/demo).",
         ),
-    ] = Path("fixtures/scenarios"),
+    ] = None,
     chart: Annotated[
-        Path,
-        typer.Option("--chart", metavar="CHART", help="Chart for the replay."),
-    ] = Path("fixtures/charts/aalborg_modelled.geojson"),
+        Path | None,
+        typer.Option(
+            "--chart", metavar="CHART", help="Chart for the replay. Default: the modelled chart."
+        ),
+    ] = None,
     query: Annotated[
-        Path,
-        typer.Option("--query", metavar="FILE", help="Query TOML with the paper's parameters."),
-    ] = Path("queries/greenhopper.toml"),
+        Path | None,
+        typer.Option(
+            "--query",
+            metavar="FILE",
+            help="Query TOML with the paper's parameters. Default: the package's greenhopper.toml.",
+        ),
+    ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
     """The paper's Greenhopper case study: simulate and replay both scenarios, print the verdicts.
 
-    Run it from the repository root (the scenarios, chart and query live in fixtures/ and
-    queries/). Writes the AIS, the replay reports and one figure per scenario to the output
-    directory. Exit code 3 if a scenario gives own ship no triggered encounter.
+    Runs from any directory: the scenarios, the modelled chart and the query are package data.
+    Writes the AIS, the replay reports and one figure per scenario to the output directory.
+    Exit code 3 if a scenario gives own ship no triggered encounter.
 
     Example: colregs9 demo --out reports/demo
     """
-    from .demo import run_demo
+    from .demo import DEFAULT_CHART, DEFAULT_QUERY, DEFAULT_SCENARIOS_DIR, run_demo
 
     with _user_errors():
-        result = run_demo(out, quiet=quiet, scenarios_dir=scenarios, chart=chart, query=query)
+        result = run_demo(
+            out,
+            quiet=quiet,
+            scenarios_dir=scenarios or DEFAULT_SCENARIOS_DIR,
+            chart=chart or DEFAULT_CHART,
+            query=query or DEFAULT_QUERY,
+        )
     typer.echo(result.text, nl=False)
 
 

@@ -2,7 +2,7 @@
 
 For each of the two scenarios (``greenhopper_restricted``, ``greenhopper_not_restricted``)
 it simulates the scenario's AIS, replays it on the modelled Aalborg chart with the paper's
-parameters (``queries/greenhopper.toml``) with the scenario's own ship (the Greenhopper) in
+parameters (``greenhopper.toml``) with the scenario's own ship (the Greenhopper) in
 the own-ship seat, and reports the verdict of her triggered encounter. Every file lands in
 one output directory:
 
@@ -12,14 +12,15 @@ one output directory:
 - ``<scenario>.png``: a copy of the encounter's figure, the paper's Figure "restricted" or
   "not restricted".
 
-The inputs live in the repository, not in the installed package, so the default paths are
-relative to the current directory (the README runs the demo from the repository root).
+The inputs (the two scenarios, the modelled chart and the query) are package data in
+``colregs9_cli/data/demo/``, so the demo runs from any directory after ``pip install``.
 """
 
 from __future__ import annotations
 
 import shutil
 from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 from .errors import InputFileError, NoDataError
@@ -29,9 +30,10 @@ from .simulate import SimulationResult, simulate_scenario
 
 SCENARIO_NAMES: tuple[str, ...] = ("greenhopper_restricted", "greenhopper_not_restricted")
 DEFAULT_OUT_DIR = Path("reports") / "demo"
-DEFAULT_SCENARIOS_DIR = Path("fixtures") / "scenarios"
-DEFAULT_CHART = Path("fixtures") / "charts" / "aalborg_modelled.geojson"
-DEFAULT_QUERY = Path("queries") / "greenhopper.toml"
+DEMO_DATA = Path(str(resources.files("colregs9_cli").joinpath("data", "demo")))
+DEFAULT_SCENARIOS_DIR = DEMO_DATA
+DEFAULT_CHART = DEMO_DATA / "aalborg_modelled.geojson"
+DEFAULT_QUERY = DEMO_DATA / "greenhopper.toml"
 
 
 @dataclass(frozen=True)
@@ -138,8 +140,8 @@ def _require(path: Path, option: str, kind: str) -> None:
     exists = path.is_dir() if kind == "directory" else path.is_file()
     if not exists:
         raise InputFileError(
-            f"{path}: no such {kind} ({option}); run from the repository root or pass "
-            "--scenarios/--chart/--query"
+            f"{path}: no such {kind} ({option}); give an existing one, or leave them out to "
+            "use the package's own"
         )
 
 

@@ -3,7 +3,7 @@
 A scenario names a start time, a duration, an integration step and an AIS reporting
 interval, an optional chart, and ``[[vessel]]`` entries, each with its static data and a
 route of waypoints (lat, lon) with a speed per leg. The format is documented in
-``fixtures/scenarios/README.md``. Every key is checked: unknown or missing keys, wrong types
+``colregs9_cli/data/demo/README.md``. Every key is checked: unknown or missing keys, wrong types
 and impossible values raise ``QueryError`` naming the file, the vessel and the key.
 
 The plausibility check puts every waypoint and every leg of every route in water navigable

@@ -1,4 +1,4 @@
-"""Generate the MODELLED Aalborg chart ``fixtures/charts/aalborg_modelled.geojson``.
+"""Generate the MODELLED Aalborg chart ``colregs9_cli/data/demo/aalborg_modelled.geojson``.
 
 The land comes from the real coastline (``fixtures/charts/aalborg_coastline.geojson``,
 DTUAqua/limfjord). Every depth in the output is INVENTED: no public Danish ENC or depth
@@ -65,7 +65,7 @@ from colregs9_cli.geo import LocalFrame
 
 ROOT = Path(__file__).resolve().parents[1]
 COASTLINE = ROOT / "fixtures" / "charts" / "aalborg_coastline.geojson"
-DEFAULT_OUT = ROOT / "fixtures" / "charts" / "aalborg_modelled.geojson"
+DEFAULT_OUT = ROOT / "colregs9_cli" / "data" / "demo" / "aalborg_modelled.geojson"
 
 SOURCE_NOTE = "MODELLED - not surveyed, not for navigation"
 REGION_R = {"lat_min": 57.044196, "lat_max": 57.062865, "lon_min": 9.909933, "lon_max": 9.971545}

@@ -34,9 +34,9 @@ def regenerate() -> list[Path]:
         result = run_demo(
             Path(tmp),
             quiet=True,
-            scenarios_dir=ROOT / "fixtures" / "scenarios",
-            chart=ROOT / "fixtures" / "charts" / "aalborg_modelled.geojson",
-            query=ROOT / "queries" / "greenhopper.toml",
+            scenarios_dir=ROOT / "colregs9_cli" / "data" / "demo",
+            chart=ROOT / "colregs9_cli" / "data" / "demo" / "aalborg_modelled.geojson",
+            query=ROOT / "colregs9_cli" / "data" / "demo" / "greenhopper.toml",
         )
         for verdict in result.verdicts:
             encounters = verdict.replay.out_dir / ENCOUNTERS_NAME

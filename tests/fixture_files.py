@@ -11,8 +11,10 @@ DMA26 = AIS_FIXTURES / "aisdk_2024-09-09_sample.csv"
 DMA22 = AIS_FIXTURES / "aisdk_2018-06-01_sample_22col.csv"
 MARINECADASTRE = AIS_FIXTURES / "marinecadastre_2023-01-11_sample.csv"
 NMEA = AIS_FIXTURES / "dma_nmea_2013-11-12_5min.txt.gz"
-SCENARIOS = FIXTURES / "scenarios"
-MODELLED_CHART = FIXTURES / "charts" / "aalborg_modelled.geojson"
-GREENHOPPER_QUERY = ROOT / "queries" / "greenhopper.toml"
+# The demo's inputs are package data, so that `colregs9 demo` runs after a plain install.
+DEMO_DATA = ROOT / "colregs9_cli" / "data" / "demo"
+SCENARIOS = DEMO_DATA
+MODELLED_CHART = DEMO_DATA / "aalborg_modelled.geojson"
+GREENHOPPER_QUERY = DEMO_DATA / "greenhopper.toml"
 SANDIEGO_AIS = ROOT / "fixtures" / "sandiego" / "marinecadastre_2022-01-03_sandiego_bay.csv"
 SANDIEGO_ENC = ROOT / "fixtures" / "sandiego" / "US5CA72M.000"

@@ -183,17 +183,18 @@ def test_missing_inputs_give_one_error_line(tmp_path: Path, missing: str) -> Non
     assert result.exit_code == InputFileError.exit_code
     assert len(lines) == 1 and lines[0].startswith("Error: "), result.output
     assert "nowhere" in lines[0] and missing in lines[0]
-    assert "run from the repository root" in lines[0]
+    assert "leave them out" in lines[0]
 
 
-def test_the_default_paths_are_relative_to_the_current_directory(
+def test_the_demo_runs_from_any_directory(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.chdir(tmp_path)  # not the repository root: nothing to find
-    result = CliRunner().invoke(app, ["demo", "--quiet"])
-    assert result.exit_code == InputFileError.exit_code
-    assert result.output.startswith("Error: fixtures/scenarios: no such directory")
-    assert not (tmp_path / "reports").exists()
+    monkeypatch.chdir(tmp_path)  # not the repository root: the inputs are package data
+    result = CliRunner().invoke(app, ["demo", "--quiet", "--out", "here"])
+    assert result.exit_code == 0, result.output
+    assert result.output.count("as in the paper") == 1
+    assert "as in the paper              yes                     yes" in result.output
+    assert (tmp_path / "here" / "greenhopper_restricted.png").is_file()
 
 
 def test_a_scenario_without_a_triggered_encounter_is_an_error(tmp_path: Path) -> None:
@@ -393,7 +394,7 @@ def test_alpha_one_still_restricted_and_no_longer_clear(demo: DemoRun, tmp_path:
 def _scenario_with_target_draught(name: str, draught_m: float, tmp_path: Path) -> Path:
     text = (SCENARIOS / f"{name}.toml").read_text(encoding="utf-8")
     edited = text.replace("draught_m = 5.0", f"draught_m = {draught_m}").replace(
-        'chart = "../charts/aalborg_modelled.geojson"', f'chart = "{MODELLED_CHART.as_posix()}"'
+        'chart = "aalborg_modelled.geojson"', f'chart = "{MODELLED_CHART.as_posix()}"'
     )
     assert edited.count(f"draught_m = {draught_m}") == 1 and MODELLED_CHART.as_posix() in edited
     path = tmp_path / f"{name}.toml"

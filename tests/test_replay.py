@@ -450,8 +450,8 @@ speed_kn = 7.0
 
 def _replay_scenario(work: Path, text: str, overrides=None):
     scenario = work / "scenario.toml"
-    # a copied scenario names its chart relative to fixtures/scenarios/
-    text = text.replace('chart = "../charts/', f'chart = "{MODELLED_CHART.parent.as_posix()}/')
+    # a copied scenario names its chart relative to colregs9_cli/data/demo/
+    text = text.replace('chart = "aalborg_', f'chart = "{MODELLED_CHART.parent.as_posix()}/aalborg_')
     scenario.write_text(text, encoding="utf-8")
     simulated = simulate_scenario(scenario, out=work / "ais.csv")
     return run_replay(

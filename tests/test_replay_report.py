@@ -25,7 +25,7 @@ from colregs9_cli.units import MPS_PER_KNOT
 from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, NMEA, ROOT
 
 OWN = 211356520  # one triggered crossing in the national sample (see test_replay.py)
-SCENARIO = ROOT / "fixtures" / "scenarios" / "greenhopper_restricted.toml"
+SCENARIO = ROOT / "colregs9_cli" / "data" / "demo" / "greenhopper_restricted.toml"
 GREENHOPPER = 219999001
 
 # The columns issue 4 asks for, in encounters.csv and in each time series.

@@ -110,7 +110,7 @@ def test_assessment_triggers_with_the_target_on_the_port_side(name: str, trigger
     triggered = np.flatnonzero((tcpa_s >= 0.0) & (tcpa_s <= 180.0) & (cpa_m < 150.0))
     assert triggered.size > 0
     first = triggered[0]
-    # the design in fixtures/scenarios/README.md: trigger time, CPA 50–60 m
+    # the design in colregs9_cli/data/demo/README.md: trigger time, CPA 50–60 m
     assert own.time_s[first] == trigger_s
     assert 40.0 < cpa_m[first] < 70.0
     # port side (relative bearing 180–360°), forward of the overtaking sector, not head-on
@@ -129,7 +129,7 @@ def _write(tmp_path: Path, text: str) -> Path:
 def _restricted_text() -> str:
     text = (SCENARIOS / "greenhopper_restricted.toml").read_text(encoding="utf-8")
     chart = MODELLED_CHART.resolve().as_posix()
-    return text.replace('chart = "../charts/aalborg_modelled.geojson"', f'chart = "{chart}"')
+    return text.replace('chart = "aalborg_modelled.geojson"', f'chart = "{chart}"')
 
 
 @pytest.mark.parametrize(
