@@ -24,7 +24,8 @@ from importlib import resources
 from pathlib import Path
 
 from .errors import InputFileError, NoDataError
-from .replay import EncounterOutcome, ReplayResult, run_replay
+from .replay import run_replay
+from .replay_results import EncounterOutcome, ReplayResult
 from .report.replay_report import ENCOUNTER_DIR
 from .simulate import SimulationResult, simulate_scenario
 

@@ -26,7 +26,8 @@ from colregs9_cli.demo import run_scenario
 from colregs9_cli.errors import InputFileError, NoDataError
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.manoeuvrability import Restriction, ellipse_polygons
-from colregs9_cli.replay import ReplayResult, run_replay
+from colregs9_cli.replay import run_replay
+from colregs9_cli.replay_results import ReplayResult
 from colregs9_cli.units import knots_to_mps
 
 from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, ROOT, SCENARIOS
@@ -186,9 +187,7 @@ def test_missing_inputs_give_one_error_line(tmp_path: Path, missing: str) -> Non
     assert "leave them out" in lines[0]
 
 
-def test_the_demo_runs_from_any_directory(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_the_demo_runs_from_any_directory(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)  # not the repository root: the inputs are package data
     result = CliRunner().invoke(app, ["demo", "--quiet", "--out", "here"])
     assert result.exit_code == 0, result.output

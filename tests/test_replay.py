@@ -31,13 +31,9 @@ from colregs9_cli.manoeuvrability import (
     verdict,
 )
 from colregs9_cli.query import everything_query
-from colregs9_cli.replay import (
-    ENCOUNTER_COLUMNS,
-    PAIR_COLUMNS,
-    run_params,
-    run_replay,
-)
+from colregs9_cli.replay import run_params, run_replay
 from colregs9_cli.replay_params import ReplayParams
+from colregs9_cli.replay_results import ENCOUNTER_COLUMNS, PAIR_COLUMNS
 from colregs9_cli.simulate import simulate_scenario
 
 from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, NMEA, SCENARIOS
@@ -451,7 +447,8 @@ speed_kn = 7.0
 def _replay_scenario(work: Path, text: str, overrides=None):
     scenario = work / "scenario.toml"
     # a copied scenario names its chart relative to colregs9_cli/data/demo/
-    text = text.replace('chart = "aalborg_', f'chart = "{MODELLED_CHART.parent.as_posix()}/aalborg_')
+    chart_dir = MODELLED_CHART.parent.as_posix()
+    text = text.replace('chart = "aalborg_', f'chart = "{chart_dir}/aalborg_')
     scenario.write_text(text, encoding="utf-8")
     simulated = simulate_scenario(scenario, out=work / "ais.csv")
     return run_replay(

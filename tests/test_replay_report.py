@@ -12,7 +12,8 @@ import pandas as pd
 import pytest
 
 from colregs9_cli.chart import load_chart
-from colregs9_cli.replay import ENCOUNTER_COLUMNS, SERIES_COLUMNS, run_replay
+from colregs9_cli.replay import run_replay
+from colregs9_cli.replay_results import ENCOUNTER_COLUMNS, SERIES_COLUMNS
 from colregs9_cli.report.chart_plot import DEPTH_LABEL, RESTRICTED_COLOUR
 from colregs9_cli.report.replay_report import (
     direction_arrows,

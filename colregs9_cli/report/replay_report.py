@@ -24,13 +24,19 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from ..replay_results import (
+    ENCOUNTER_COLUMNS,
+    PAIR_COLUMNS,
+    EncounterOutcome,
+    PairOutcome,
+    ReplayResult,
+)
 from .atomic import report_directory, save_figure, write_csv, write_json, write_text
 from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart
 
 if TYPE_CHECKING:
     from ..chart import Chart
     from ..progress import ProgressSink
-    from ..replay import EncounterOutcome, PairOutcome, ReplayResult
 
 ENCOUNTERS_NAME = "encounters.csv"
 PAIRS_NAME = "pairs.csv"
@@ -76,15 +82,11 @@ def _summary_table(summaries: list[Any], columns: tuple[str, ...]) -> pd.DataFra
 
 def encounters_frame(outcomes: tuple[EncounterOutcome, ...]) -> pd.DataFrame:
     """encounters.csv: one row per triggered encounter per seat, ``EncounterSummary``'s columns."""
-    from ..replay import ENCOUNTER_COLUMNS
-
     return _summary_table([o.summary for o in outcomes], ENCOUNTER_COLUMNS)
 
 
 def pairs_frame(pairs: tuple[PairOutcome, ...]) -> pd.DataFrame:
     """pairs.csv: one row per triggered pair, ``PairSummary``'s columns."""
-    from ..replay import PAIR_COLUMNS
-
     return _summary_table([p.summary for p in pairs], PAIR_COLUMNS)
 
 
