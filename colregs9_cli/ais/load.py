@@ -51,6 +51,7 @@ import io
 import re
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import TypeAlias
 
@@ -283,12 +284,18 @@ class _FileResult:
         """Rows in the region: canonical, then checked for their timestamp, the time window
         and the vessel filter."""
         table, bad_time = self.conversion.canonical(part.table)
+        bad_time = bad_time | _time_out_of_range(table)
         if bad_time.any():
             first = int(np.flatnonzero(bad_time)[0])
             self.ledger.reject(
                 RejectReason.UNPARSEABLE,
                 int(bad_time.sum()),
-                example=part.example(first, "time", "timestamp does not parse:"),
+                example=part.example(
+                    first,
+                    "time",
+                    f"timestamp does not parse or lies outside {AIS_TIME_MIN:%Y}–"
+                    f"{AIS_TIME_END.year - 1}:",
+                ),
             )
             self._uncount_dimensions(table.filter(pa.array(bad_time)))
             table = table.filter(pa.array(~bad_time))
@@ -586,6 +593,21 @@ def _classify(
         left[rows[~inside]] = False
     if left.any():
         result.set_aside(kept=cut(np.flatnonzero(left)))
+
+
+# AIS began in the late 1990s; a time outside these years is a corrupt field, and years past
+# 2262 would not even fit pandas' nanosecond times later on.
+AIS_TIME_MIN = datetime(1980, 1, 1, tzinfo=UTC)
+AIS_TIME_END = datetime(2100, 1, 1, tzinfo=UTC)
+
+
+def _time_out_of_range(table: pa.Table) -> np.ndarray:
+    """Rows whose timestamp lies outside [AIS_TIME_MIN, AIS_TIME_END)."""
+    milliseconds = table.column("timestamp").cast(pa.int64()).to_numpy(zero_copy_only=False)
+    low = round(AIS_TIME_MIN.timestamp() * 1000)
+    high = round(AIS_TIME_END.timestamp() * 1000)
+    with np.errstate(invalid="ignore"):
+        return np.asarray((milliseconds < low) | (milliseconds >= high), dtype=bool)
 
 
 def _in_query(table: pa.Table, query: Query) -> np.ndarray:
