@@ -160,7 +160,8 @@ def test_kept_row_with_a_bad_timestamp_reports_no_dimensions(tmp_path: Path) -> 
     data = load_ais([with_broken])
     assert data.ledger.rejects["unparseable"] == 1
     assert data.ledger.examples["unparseable"] == [
-        f"{with_broken}:3: timestamp does not parse or lies outside 1980–2099: '32/13/2024 99:00:00'"
+        f"{with_broken}:3: timestamp does not parse or lies outside 1980–2099: "
+        "'32/13/2024 99:00:00'"
     ]
     pd.testing.assert_frame_equal(data.dimension_reports, load_ais([without]).dimension_reports)
     assert data.dimension_reports["length_m"].tolist() == [288.0]
