@@ -85,7 +85,7 @@ from .replay_results import (
     VesselAtTrigger,
 )
 from .report.atomic import check_out_dir
-from .report.manifest import inputs_manifest, jsonable, query_manifest, run_header
+from .report.manifest import charts_manifest, inputs_manifest, jsonable, query_manifest, run_header
 from .report.replay_report import format_summary, write_replay_reports
 from .rule9 import Finding, PairVerdict, decide_pair, nav_status_finding
 from .tracks import Tracks, build_tracks
@@ -794,7 +794,7 @@ def build_manifest(
         "frame": {"lat0_deg": frame.lat0_deg, "lon0_deg": frame.lon0_deg},
         "parameters": jsonable(params),
         "inputs": inputs_manifest(data.inputs),
-        "charts": [str(p) for p in chart_paths],
+        "charts": charts_manifest(chart_paths),
         "ledger": ledger.to_dict(),
         "ledger_balanced": ledger.balanced,
         "tracks": jsonable(tracks.stats),

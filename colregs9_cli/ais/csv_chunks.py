@@ -40,7 +40,6 @@ import collections
 import csv
 import functools
 import io
-import sys
 from collections.abc import Generator, Mapping, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
@@ -55,13 +54,6 @@ CHUNK_BYTES = 16 * 1024 * 1024
 # pyarrow's parallel unit inside a chunk.
 PARSE_BLOCK_BYTES = 4 * 1024 * 1024
 _NEWLINE, _CARRIAGE_RETURN, _FIRST_NON_ASCII = 10, 13, 128
-# Piece buffers are sized in steps of this beyond CHUNK_BYTES, so that they can be reused.
-_CARRY_ROOM = 64 * 1024
-# Buffers kept for reuse: enough for the chunks read ahead and being parsed.
-_MAX_BUFFERS = 32
-# The references to a buffer no chunk holds: the pool's list, the loop's name and
-# ``sys.getrefcount``'s argument.
-_UNREFERENCED = 3
 
 
 class NotUtf8(Exception):
@@ -321,27 +313,15 @@ class _Pieces:
         self._carry = b""
         self._skip_header = skip_header
         self._ended = False
-        self._buffers: list[bytearray] = []
         self.first_line = first_line
-
-    def _buffer(self, carried: int) -> bytearray:
-        """A buffer for the carried bytes and a chunk: an earlier one that nothing refers to
-        any more (no chunk, view or table), else a new one. A new 16 MB buffer costs about
-        4 ms of zeroing and page faults, as much as finding its line ends."""
-        size = CHUNK_BYTES + -(-carried // _CARRY_ROOM) * _CARRY_ROOM
-        for buffer in self._buffers:
-            if len(buffer) == size and sys.getrefcount(buffer) <= _UNREFERENCED:
-                return buffer
-        buffer = bytearray(size)
-        if len(self._buffers) < _MAX_BUFFERS:
-            self._buffers.append(buffer)
-        return buffer
 
     def read(self) -> tuple[memoryview, bool] | None:
         """The next piece, and whether it holds a carriage return; None from the end on."""
         while not self._ended:
             carried = len(self._carry)
-            buffer = self._buffer(carried)
+            # A new buffer per piece: a chunk, and the tables parsed from it, keep it alive
+            # for as long as they need it (room for the carried bytes, a chunk and a newline).
+            buffer = bytearray(carried + CHUNK_BYTES + 1)
             buffer[:carried] = self._carry
             room = memoryview(buffer)[carried : carried + CHUNK_BYTES]
             got = self._stream.readinto(room)  # type: ignore[attr-defined]

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
+import sys
 from collections.abc import Mapping, Sequence
 from datetime import UTC, datetime
 from enum import Enum
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import pandas as pd
@@ -50,8 +53,34 @@ def run_header(command: str) -> dict[str, Any]:
         "tool": "colregs9",
         "version": __version__,
         "command": command,
+        "argv": list(sys.argv),
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }
+
+
+def charts_manifest(paths: Sequence[Path]) -> list[dict[str, Any]]:
+    """Each chart given, with every file that went into it and its sha256: an S-57 base
+    cell ``X.000`` with the update files ``X.001``, ``X.002`` … that lie beside it."""
+    charts = []
+    for path in paths:
+        files = [path]
+        if path.suffix == ".000":
+            number = 1
+            while (update := path.with_suffix(f".{number:03d}")).is_file():
+                files.append(update)
+                number += 1
+        charts.append(
+            {
+                "path": str(path),
+                "files": [{"path": str(f), "sha256": _sha256(f)} for f in files],
+            }
+        )
+    return charts
+
+
+def _sha256(path: Path) -> str:
+    with path.open("rb") as handle:
+        return hashlib.file_digest(handle, "sha256").hexdigest()
 
 
 def query_manifest(query: Query) -> dict[str, Any]:
