@@ -823,7 +823,7 @@ def run_replay(
     """
     query = load_query(query_path) if query_path is not None else everything_query()
     params = run_params(query, own_mmsi, overrides)
-    target = out_dir if out_dir is not None else default_out_dir(query.name)
+    target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
     check_out_dir(target, overwrite)
     data = load_ais(ais_paths, query=query, fmt=fmt, quiet=quiet)
     positions = data.positions

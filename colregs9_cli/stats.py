@@ -68,7 +68,7 @@ def run_stats(
         query = load_query(query_path) if query_path is not None else everything_query()
         from .report.atomic import check_out_dir
 
-        target = out_dir if out_dir is not None else default_out_dir(query.name)
+        target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
         check_out_dir(target, overwrite)
         from .ais.load import load_ais
         from .dimensions import GroupBy, Per, dimension_stats

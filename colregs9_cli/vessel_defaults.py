@@ -20,6 +20,8 @@ from typing import Any
 
 import pandas as pd
 
+from .ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
+
 DIMENSIONS: tuple[str, ...] = ("length_m", "breadth_m", "draught_m")
 ANY = "*"
 
@@ -62,12 +64,16 @@ def _table_row(mobile_type: str | None, ship_type: str | None) -> pd.Series:
     raise LookupError("data/default_dimensions.csv has no '*,*' row")
 
 
-def _reported(value: Any) -> float | None:
-    """A usable AIS dimension, or None (missing, zero, negative or not finite)."""
+_LIMITS_M = {"length_m": MAX_LENGTH_M, "breadth_m": MAX_BREADTH_M, "draught_m": MAX_DRAUGHT_M}
+
+
+def _reported(name: str, value: Any) -> float | None:
+    """A usable AIS dimension, or None (missing, zero, negative, not finite or beyond what a
+    ship has: ``ais.clean``'s limits)."""
     if value is None or pd.isna(value):
         return None
     number = float(value)
-    return number if math.isfinite(number) and number > 0.0 else None
+    return number if math.isfinite(number) and 0.0 < number <= _LIMITS_M[name] else None
 
 
 def vessel_dimensions(
@@ -79,7 +85,7 @@ def vessel_dimensions(
     ``overrides`` maps a dimension to a value that replaces the table for every vessel that
     does not report it (``None``: use the table).
     """
-    given = {name: _reported(static.get(name)) for name in DIMENSIONS}
+    given = {name: _reported(name, static.get(name)) for name in DIMENSIONS}
     missing = tuple(name for name, value in given.items() if value is None)
     row = _table_row(_text(static.get("mobile_type")), _text(static.get("ship_type")))
     overrides = overrides or {}

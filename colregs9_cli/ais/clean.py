@@ -228,6 +228,23 @@ def is_vessel(mobile_type: pa.Array) -> BoolArray:
 
 Dimensions = tuple[FloatArray, FloatArray, FloatArray]
 
+# The largest dimensions a ship has (metres): the longest ships are under 460 m, the widest
+# under 70 m, and AIS encodes a draught of at most 25.5 m. Beyond these, or not finite, a
+# value is a corrupt field (``inf``, ``1e400``) and is treated as not available.
+MAX_LENGTH_M = 500.0
+MAX_BREADTH_M = 80.0
+MAX_DRAUGHT_M = 30.0
+
+
+def plausible(dimensions: Dimensions) -> Dimensions:
+    """Length, breadth and draught with implausible values (module limits) as NaN."""
+    length_m, breadth_m, draught_m = dimensions
+    return (
+        null_outside(length_m, 0.0, MAX_LENGTH_M),
+        null_outside(breadth_m, 0.0, MAX_BREADTH_M),
+        null_outside(draught_m, 0.0, MAX_DRAUGHT_M),
+    )
+
 
 @dataclass(frozen=True)
 class DimensionColumns:

@@ -34,6 +34,7 @@ from .clean import (
     nav_status_from_text,
     null_outside,
     number_problems,
+    plausible,
     positive_or_nan,
     whole_positive,
 )
@@ -50,8 +51,10 @@ def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
     draught, _ = float_column(batch.column("draught"))
     if has_abcd:
         a, b, c, d = (float_column(batch.column(k))[0] for k in DMA_ABCD)
-        return dimension(a, b, length), dimension(c, d, width), positive_or_nan(draught)
-    return positive_or_nan(length), positive_or_nan(width), positive_or_nan(draught)
+        return plausible(
+            (dimension(a, b, length), dimension(c, d, width), positive_or_nan(draught))
+        )
+    return plausible((positive_or_nan(length), positive_or_nan(width), positive_or_nan(draught)))
 
 
 def dma_fields(batch: pa.RecordBatch, has_abcd: bool) -> Fields:

@@ -73,6 +73,7 @@ from .clean import (
     clean_text,
     is_vessel,
     null_outside,
+    plausible,
     to_numpy_float,
     valid_mmsi,
 )
@@ -636,7 +637,7 @@ def _in_query(table: pa.Table, query: Query) -> np.ndarray:
 
 def _canonical_dimensions(table: pa.Table) -> Dimensions:
     length_m, breadth_m, draught_m = (to_numpy_float(table.column(name)) for name in DIMENSIONS)
-    return length_m, breadth_m, draught_m
+    return plausible((length_m, breadth_m, draught_m))
 
 
 def _canonical_fields(table: pa.Table) -> Fields:

@@ -30,6 +30,7 @@ from .clean import (
     nan_to_null,
     null_outside,
     number_problems,
+    plausible,
     positive_or_nan,
     whole_positive,
 )
@@ -76,7 +77,7 @@ def marinecadastre_fields(batch: pa.RecordBatch) -> Fields:
 
 def _dimensions(table: pa.Table) -> Dimensions:
     length, breadth, draught = (float_column(table.column(c))[0] for c in DIMENSION_COLUMNS)
-    return positive_or_nan(length), positive_or_nan(breadth), positive_or_nan(draught)
+    return plausible((positive_or_nan(length), positive_or_nan(breadth), positive_or_nan(draught)))
 
 
 def marinecadastre_static_text(batch: pa.RecordBatch) -> BoolArray:

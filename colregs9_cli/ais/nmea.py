@@ -85,7 +85,7 @@ from pyais.messages import (
 
 from ..errors import ParameterError
 from .batch import STATIC_SCHEMA, AisBatch
-from .clean import SHIP_TYPE_CATEGORIES
+from .clean import MAX_BREADTH_M, MAX_LENGTH_M, SHIP_TYPE_CATEGORIES, null_outside
 from .ledger import RejectReason, RejectsLedger
 from .schema import CANONICAL_SCHEMA
 
@@ -570,8 +570,14 @@ def _static_frame(columns: _Columns) -> pd.DataFrame:
             "timestamp": np.array(columns.timestamp, dtype=np.int64),
             "mmsi": np.array(columns.mmsi, dtype=np.int64),
             "ship_type": _null_where(ship_type, ~(ship_type > 0)),
-            "length_m": _dimension(_floats(columns.to_bow), _floats(columns.to_stern)),
-            "breadth_m": _dimension(_floats(columns.to_port), _floats(columns.to_starboard)),
+            "length_m": null_outside(
+                _dimension(_floats(columns.to_bow), _floats(columns.to_stern)), 0.0, MAX_LENGTH_M
+            ),
+            "breadth_m": null_outside(
+                _dimension(_floats(columns.to_port), _floats(columns.to_starboard)),
+                0.0,
+                MAX_BREADTH_M,
+            ),
             "draught_m": _null_where(draught, ~(draught > 0)),
             "name": _text(columns.name),
             "callsign": _text(columns.callsign),
