@@ -162,6 +162,29 @@ class Chart:
             )
         )
 
+    def covers_shapes(
+        self, north_m: NDArray[np.float64], east_m: NDArray[np.float64], shapes: Any, reach_m: float
+    ) -> NDArray[np.bool_]:
+        """True where a shape lies wholly inside the charted extent: the edge of a chart is not
+        the edge of the water. ``shapes`` is called with the indices of the positions within
+        ``reach_m`` (the shapes' largest extent from their position) of the extent's boundary
+        and returns their polygons; the others are decided by their position alone."""
+        covered = self.covers(north_m, east_m)
+        near = np.flatnonzero(
+            covered
+            & np.asarray(
+                shapely.dwithin(
+                    self._coverage_boundary,
+                    shapely.points(np.column_stack([east_m, north_m])),
+                    reach_m,
+                ),
+                dtype=bool,
+            )
+        )
+        if len(near):
+            covered[near] = shapely.contains(self.coverage, shapes(near))
+        return covered
+
     def covers_disk(self, north_m: float, east_m: float, radius_m: float) -> bool:
         """Whether every point within ``radius_m`` of the position lies inside the extent."""
         return bool(self.covers(north_m, east_m)[0]) and not bool(

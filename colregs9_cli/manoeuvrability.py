@@ -19,10 +19,11 @@
    words. The verdict over both arcs follows a ``RestrictionPolicy``.
 
 Unknown chart coverage is three-valued, never "clear": no chart, or the target's present
-position outside the chart, gives ``UNKNOWN``. A projected position outside the chart's
-coverage may be either red or blue; the verdict is ``RESTRICTED`` when the policy holds on
-the covered red positions alone, ``NOT_RESTRICTED`` when it fails even if every uncovered
-position were red, and ``UNKNOWN`` in between.
+position outside the chart, gives ``UNKNOWN``. A projected position is covered only when its
+whole ellipse lies inside the chart's coverage (the edge of a chart is not the edge of the
+water); an uncovered one may be either red or blue. The verdict is ``RESTRICTED`` when the
+policy holds on the covered red positions alone, ``NOT_RESTRICTED`` when it fails even if
+every uncovered position were red, and ``UNKNOWN`` in between.
 """
 
 from __future__ import annotations
@@ -381,7 +382,8 @@ class ManoeuvrabilityAssessment:
 
     ``rate_of_swing_deg_per_m`` is the scaled δ' and ``turn_radius_m`` = 1/δ' (rad/m).
     ``restricted`` is the geometric flag (ellipse not inside navigable water); ``covered``
-    tells whether the position is inside the chart. ``ellipses`` is built on first use.
+    tells whether the position's whole ellipse is inside the chart. ``ellipses`` is built on
+    first use.
     """
 
     restriction: Restriction
@@ -449,12 +451,20 @@ def assess_manoeuvrability(
         restricted = np.zeros(len(arcs.arc), dtype=bool)
         restriction = Restriction.UNKNOWN
     else:
-        # No projected position is farther from the start than the path sailed.
-        reach_m = speed_mps * params.step_s * params.steps
+        # No ellipse reaches farther from the start than the path sailed and its semi-axis.
+        reach_m = speed_mps * params.step_s * params.steps + max(a_m, b_m)
         if chart.covers_disk(north_m, east_m, reach_m):
             covered, start_covered = np.ones(len(arcs.arc), dtype=bool), True
         else:
-            covered = chart.covers(arcs.north_m, arcs.east_m)
+            # An ellipse that reaches past the chart is unknown, never red (``verdict``).
+            covered = chart.covers_shapes(
+                arcs.north_m,
+                arcs.east_m,
+                lambda rows: ellipse_polygons(
+                    arcs.north_m[rows], arcs.east_m[rows], arcs.heading_deg[rows], a_m, b_m
+                ),
+                max(a_m, b_m),
+            )
             start_covered = bool(chart.covers(north_m, east_m)[0])
         restricted = restricted_flags(
             chart.water_index(draught_m, params.ukc_m),
