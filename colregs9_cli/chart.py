@@ -111,6 +111,7 @@ class Chart:
     hazards: Any
     coverage: Any
     sources: tuple[Path, ...] = ()
+    cells: tuple[CellInfo, ...] = ()
     layer_counts: Mapping[str, int] = field(default_factory=dict)
     hazard_areas: NDArray[np.object_] = field(default_factory=lambda: np.empty(0, dtype=object))
     hazard_depth_m: NDArray[np.float64] = field(default_factory=lambda: np.empty(0))
@@ -406,11 +407,83 @@ def _read_features(path: Path) -> _Features:
 
 
 @dataclass(frozen=True)
+class CellInfo:
+    """An S-57 cell's identity as read from its DSID record after the updates were applied.
+
+    ``update_files`` are the update files beside the base cell, in order; ``missing_updates``
+    names the files missing from that sequence, when the user accepted the gap (GDAL then
+    applies the updates before the gap and none after it: ``update_number`` tells which).
+    """
+
+    path: Path
+    name: str
+    edition: int | None
+    update_number: int | None
+    issue_date: str | None
+    update_files: tuple[Path, ...]
+    missing_updates: tuple[str, ...]
+
+
+def _update_files(path: Path) -> tuple[list[Path], list[str]]:
+    """The update files ``X.001``, ``X.002`` … beside the base cell ``X.000``, and the names
+    of those missing below the highest one present."""
+    numbers = sorted(
+        int(candidate.suffix[1:])
+        for candidate in path.parent.glob(f"{path.stem}.*")
+        if len(candidate.suffix) == 4
+        and candidate.suffix[1:].isdigit()
+        and candidate.suffix != ".000"
+    )
+    present = set(numbers)
+    highest = numbers[-1] if numbers else 0
+    missing = [f"{path.stem}.{n:03d}" for n in range(1, highest + 1) if n not in present]
+    return [path.with_suffix(f".{n:03d}") for n in numbers], missing
+
+
+def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
+    """The cell's edition, update number and issue date; a gap in its update sequence is a
+    ``ChartError`` unless ``accept_gaps`` (GDAL would stop at the gap without a word)."""
+    updates, missing = _update_files(path)
+    if missing and not accept_gaps:
+        raise ChartError(
+            f"{path}: the update sequence has a gap, {', '.join(missing)} missing beside "
+            f"{', '.join(u.name for u in updates)}; GDAL would apply the updates before the gap "
+            "and silently skip the rest. Put the missing update files beside the cell, or "
+            "pass --accept-chart-gaps to use the cell as updated up to the gap"
+        )
+    fields: dict[str, Any] = {}
+    try:
+        meta, _, _, values = pyogrio.raw.read(
+            path, layer="DSID", read_geometry=False, **S57_OPEN_OPTIONS
+        )
+        fields = {name: column[0] for name, column in zip(meta["fields"], values, strict=True)}
+    except (DataSourceError, DataLayerError, FieldError, RuntimeError, IndexError):
+        fields = {}
+
+    def number(name: str) -> int | None:
+        value = fields.get(name)
+        return int(value) if value is not None and str(value).strip().isdigit() else None
+
+    issue = fields.get("DSID_ISDT")
+    return CellInfo(
+        path=path,
+        name=str(fields.get("DSID_DSNM") or path.name),
+        edition=number("DSID_EDTN"),
+        update_number=number("DSID_UPDN"),
+        issue_date=None if not issue else str(issue),
+        update_files=tuple(updates),
+        missing_updates=tuple(missing),
+    )
+
+
+@dataclass(frozen=True)
 class ChartSource:
-    """Charts read from their files in WGS84, not yet projected: read once, project once."""
+    """Charts read from their files in WGS84, not yet projected: read once, project once.
+    ``cells`` describes the S-57 cells among them."""
 
     paths: tuple[Path, ...]
     features: tuple[_Features, ...]
+    cells: tuple[CellInfo, ...] = ()
 
     def bounds_wgs84(self) -> tuple[float, float, float, float]:
         """(lat_min, lat_max, lon_min, lon_max) of the charts' features."""
@@ -420,14 +493,18 @@ class ChartSource:
         return float(lat_min), float(lat_max), float(lon_min), float(lon_max)
 
 
-def read_charts(paths: Sequence[Path]) -> ChartSource:
-    """Read every chart file (S-57, GeoJSON, GeoPackage); errors name the file."""
+def read_charts(paths: Sequence[Path], accept_gaps: bool = False) -> ChartSource:
+    """Read every chart file (S-57, GeoJSON, GeoPackage); errors name the file. An S-57
+    cell's update sequence is checked first (``s57_cell_info``)."""
     if not paths:
         raise ChartError("no chart given; give at least one chart file")
-    return ChartSource(
-        paths=tuple(Path(p) for p in paths),
-        features=tuple(_read_features(Path(p)) for p in paths),
+    files = tuple(Path(p) for p in paths)
+    cells = tuple(
+        s57_cell_info(p, accept_gaps)
+        for p in files
+        if p.suffix.lower() in S57_SUFFIXES and p.is_file()
     )
+    return ChartSource(paths=files, features=tuple(_read_features(p) for p in files), cells=cells)
 
 
 def _project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
@@ -442,9 +519,11 @@ def _project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
     return projected
 
 
-def load_chart(paths: Sequence[Path], frame: LocalFrame | None = None) -> Chart:
+def load_chart(
+    paths: Sequence[Path], frame: LocalFrame | None = None, accept_gaps: bool = False
+) -> Chart:
     """Read and merge charts, project them into ``frame`` (default: centred on their extent)."""
-    return project_charts(read_charts(paths), frame)
+    return project_charts(read_charts(paths, accept_gaps), frame)
 
 
 def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Chart:
@@ -483,6 +562,7 @@ def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Char
         hazards=shapely.union_all(hazard_areas),
         coverage=coverage,
         sources=source.paths,
+        cells=source.cells,
         layer_counts={name: counts[name] for name in _OBJECT_CLASSES if name in counts},
         hazard_areas=hazard_areas,
         hazard_depth_m=hazard_depth,

@@ -12,7 +12,7 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
 
-from .chart import Chart, load_chart
+from .chart import CellInfo, Chart, load_chart
 from .errors import ParameterError
 from .progress import progress_bar, progress_enabled
 from .report.atomic import save_figure
@@ -34,10 +34,25 @@ def _check_depth(name: str, value: float | None) -> None:
         raise ParameterError(f"--{name} {value} m is negative; give a value >= 0")
 
 
+def format_cell(cell: CellInfo) -> str:
+    """One S-57 cell's identity: edition, update number, issue date, accepted gaps."""
+    edition = "?" if cell.edition is None else str(cell.edition)
+    update = "?" if cell.update_number is None else str(cell.update_number)
+    issued = "" if cell.issue_date is None else f", issued {cell.issue_date}"
+    files = f"{len(cell.update_files)} update file(s)"
+    gap = (
+        f"; GAP ACCEPTED, missing {', '.join(cell.missing_updates)}" if cell.missing_updates else ""
+    )
+    return f"  {cell.name}: edition {edition}, update {update}{issued} ({files}{gap})"
+
+
 def format_chart_summary(chart: Chart) -> str:
     lat_min, lat_max, lon_min, lon_max = chart.bounds_wgs84()
     depth_min, depth_max = chart.depth_range_m()
-    lines = ["Charts: " + ", ".join(str(p) for p in chart.sources), "Layers (features):"]
+    lines = ["Charts: " + ", ".join(str(p) for p in chart.sources)]
+    if chart.cells:
+        lines += ["S-57 cells:", *(format_cell(cell) for cell in chart.cells)]
+    lines += ["Layers (features):"]
     lines += [f"  {name:<7} {count:>6}" for name, count in chart.layer_counts.items()]
     lines += [
         f"Depth areas: {len(chart.depth_areas)}, DRVAL1 {depth_min:g} .. {depth_max:g} m",
@@ -53,6 +68,7 @@ def summarise_chart(
     ukc_m: float = 0.0,
     out: Path | None = None,
     quiet: bool = False,
+    accept_gaps: bool = False,
 ) -> ChartSummary:
     """Load the charts and summarise them; with a draught, add its navigable area and a plot.
 
@@ -61,7 +77,7 @@ def summarise_chart(
     _check_depth("draught", draught_m)
     _check_depth("ukc", ukc_m)
     with progress_bar("Reading charts", 1, progress_enabled(quiet)) as bar:
-        chart = load_chart(paths)
+        chart = load_chart(paths, accept_gaps=accept_gaps)
         bar.advance()
     text = format_chart_summary(chart)
     if draught_m is None:

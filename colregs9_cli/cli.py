@@ -131,6 +131,14 @@ def replay_command(
         float | None,
         typer.Option("--alpha", metavar="A", help="Scale α of the rate of swing, in [0, 1]; 0.4."),
     ] = None,
+    accept_chart_gaps: Annotated[
+        bool,
+        typer.Option(
+            "--accept-chart-gaps",
+            help="Use an S-57 cell whose update sequence has a gap, as updated up to the gap "
+            "(recorded in run.json).",
+        ),
+    ] = False,
     overwrite: Annotated[
         bool,
         typer.Option(
@@ -171,6 +179,7 @@ def replay_command(
             fmt=fmt,
             quiet=quiet,
             overwrite=overwrite,
+            accept_chart_gaps=accept_chart_gaps,
         )
     typer.echo(result.text, nl=False)
     typer.echo(f"Reports in {result.out_dir}")
@@ -341,6 +350,14 @@ def chart_command(
             help="Plot file (with --draught); reports/chart-<stem>.png.",
         ),
     ] = None,
+    accept_chart_gaps: Annotated[
+        bool,
+        typer.Option(
+            "--accept-chart-gaps",
+            help="Use an S-57 cell whose update sequence has a gap, as updated up to the gap "
+            "(recorded in run.json).",
+        ),
+    ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
     """Summarise charts: layers, depth range, extent; with --draught, the navigable water.
@@ -350,7 +367,14 @@ def chart_command(
     from .chartinfo import summarise_chart
 
     with _user_errors():
-        summary = summarise_chart(charts, draught_m=draught, ukc_m=ukc, out=out, quiet=quiet)
+        summary = summarise_chart(
+            charts,
+            draught_m=draught,
+            ukc_m=ukc,
+            out=out,
+            quiet=quiet,
+            accept_gaps=accept_chart_gaps,
+        )
     typer.echo(summary.text, nl=False)
 
 

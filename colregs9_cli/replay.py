@@ -756,13 +756,17 @@ def _no_overlap(chart_paths: Sequence[Path], positions: pd.DataFrame) -> ChartEr
 
 
 def load_run_chart(
-    chart_paths: Sequence[Path], frame: LocalFrame, positions: pd.DataFrame
+    chart_paths: Sequence[Path],
+    frame: LocalFrame,
+    positions: pd.DataFrame,
+    accept_gaps: bool = False,
 ) -> Chart:
-    """The charts in the run's frame; a chart that covers none of the AIS is an error.
+    """The charts in the run's frame; a chart that covers none of the AIS is an error, and so
+    is a gap in an S-57 cell's update sequence unless ``accept_gaps``.
 
     The boxes are compared first, so that a chart far away is never projected into the frame.
     """
-    source = read_charts(chart_paths)
+    source = read_charts(chart_paths, accept_gaps)
     lat_min, lat_max, lon_min, lon_max = source.bounds_wgs84()
     lat = positions["lat_deg"].to_numpy(dtype=float)
     lon = positions["lon_deg"].to_numpy(dtype=float)
@@ -780,6 +784,7 @@ def build_manifest(
     query: Query,
     data: AisData,
     ledger: RejectsLedger,
+    chart: Chart | None,
     chart_paths: Sequence[Path],
     frame: LocalFrame,
     params: ReplayRunParams,
@@ -795,6 +800,7 @@ def build_manifest(
         "parameters": jsonable(params),
         "inputs": inputs_manifest(data.inputs),
         "charts": charts_manifest(chart_paths),
+        "chart_cells": [jsonable(cell) for cell in (chart.cells if chart is not None else ())],
         "ledger": ledger.to_dict(),
         "ledger_balanced": ledger.balanced,
         "tracks": jsonable(tracks.stats),
@@ -814,6 +820,7 @@ def run_replay(
     fmt: str | None = None,
     quiet: bool = True,
     overwrite: bool = False,
+    accept_chart_gaps: bool = False,
 ) -> ReplayResult:
     """Replay ``ais_paths`` and write the reports (see the module docstring).
 
@@ -837,7 +844,7 @@ def run_replay(
     frame = run_frame(query, positions)
     chart: Chart | None = None
     if chart_paths:
-        chart = load_run_chart(chart_paths, frame, positions)
+        chart = load_run_chart(chart_paths, frame, positions, accept_chart_gaps)
 
     tracks = build_tracks(positions, frame, params.replay, params.colregs.course_source)
     ledger = _ledger_with_tracks(data.ledger, tracks)
@@ -850,7 +857,7 @@ def run_replay(
             bar.advance()
     counts = _counts(tracks, search)
     manifest = build_manifest(
-        query, data, ledger, chart_paths, frame, params, tracks, counts, tuple(outcomes)
+        query, data, ledger, chart, chart_paths, frame, params, tracks, counts, tuple(outcomes)
     )
     result = ReplayResult(
         query_name=query.name,

@@ -1,0 +1,73 @@
+"""S-57 cells: their edition, update number and issue date are reported, and a gap in their
+update sequence is never silent (GDAL would apply the updates before it and stop)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from colregs9_cli.chart import read_charts, s57_cell_info
+from colregs9_cli.cli import app
+from colregs9_cli.errors import ChartError
+from colregs9_cli.replay import run_replay
+
+from fixture_files import SANDIEGO_AIS, SANDIEGO_ENC
+
+
+def test_the_sandiego_cell_with_both_updates() -> None:
+    cell = s57_cell_info(SANDIEGO_ENC)
+    assert (cell.edition, cell.update_number, cell.issue_date) == (56, 2, "20250428")
+    assert [p.name for p in cell.update_files] == ["US5CA72M.001", "US5CA72M.002"]
+    assert cell.missing_updates == ()
+
+
+@pytest.fixture()
+def gap(tmp_path: Path) -> Path:
+    """The cell with .002 but without .001."""
+    for name in ("US5CA72M.000", "US5CA72M.002"):
+        shutil.copyfile(SANDIEGO_ENC.with_name(name), tmp_path / name)
+    return tmp_path / "US5CA72M.000"
+
+
+def test_a_gap_is_an_error_naming_the_missing_file(gap: Path) -> None:
+    with pytest.raises(ChartError, match=r"US5CA72M\.001 missing.*--accept-chart-gaps"):
+        read_charts([gap])
+
+
+def test_an_accepted_gap_is_the_cell_as_updated_up_to_it(gap: Path) -> None:
+    (cell,) = read_charts([gap], accept_gaps=True).cells
+    assert cell.missing_updates == ("US5CA72M.001",)
+    assert cell.update_number == 0  # nothing after the gap was applied
+    assert cell.edition == 56
+
+
+def test_the_chart_command_prints_the_cell_and_refuses_a_gap(gap: Path) -> None:
+    shown = CliRunner().invoke(app, ["chart", str(SANDIEGO_ENC), "--quiet"])
+    assert shown.exit_code == 0, shown.output
+    assert "US5CA72M.000: edition 56, update 2, issued 20250428" in shown.output
+    refused = CliRunner().invoke(app, ["chart", str(gap), "--quiet"])
+    assert refused.exit_code == ChartError.exit_code
+    lines = [line for line in refused.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error: ") and "US5CA72M.001" in lines[0]
+    accepted = CliRunner().invoke(app, ["chart", str(gap), "--quiet", "--accept-chart-gaps"])
+    assert accepted.exit_code == 0 and "GAP ACCEPTED" in accepted.output
+
+
+def test_replay_records_the_cells_in_run_json(tmp_path: Path, gap: Path) -> None:
+    with pytest.raises(ChartError):
+        run_replay([SANDIEGO_AIS], chart_paths=[gap], out_dir=tmp_path / "refused", plots=False)
+    result = run_replay(
+        [SANDIEGO_AIS],
+        chart_paths=[gap],
+        out_dir=tmp_path / "accepted",
+        plots=False,
+        accept_chart_gaps=True,
+    )
+    manifest = json.loads((result.out_dir / "run.json").read_text(encoding="utf-8"))
+    (cell,) = manifest["chart_cells"]
+    assert cell["edition"] == 56 and cell["update_number"] == 0
+    assert cell["missing_updates"] == ["US5CA72M.001"]
