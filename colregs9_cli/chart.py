@@ -29,6 +29,8 @@ structure: a position outside it is "unknown", never "deep".
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
@@ -239,6 +241,9 @@ class _Features:
     drval1_m: NDArray[np.float64]
     drval2_m: NDArray[np.float64]
     valsou_m: NDArray[np.float64]
+    coverage: Any = None  # M_COVR (CATCOV 1 less CATCOV 2) in WGS84; None: not given
+    purpose: int = 0  # navigational purpose, 1 overview … 6 berthing (DSID INTU); 0 unknown
+    scale: float = math.inf  # compilation scale denominator (DSPM CSCL); inf unknown
 
 
 def _numeric(values: Any, path: Path, column: str) -> NDArray[np.float64]:
@@ -306,11 +311,58 @@ def _read_s57(path: Path) -> _Features:
         if name in layers:
             meta, geometries = _read_layer(path, name, **S57_OPEN_OPTIONS)
             parts.append((geometries, name, meta["columns"]))
-    return _assemble(path, parts)
+    features = _assemble(path, parts)
+    coverage = None
+    if "M_COVR" in layers:
+        meta, geometries = _read_layer(path, "M_COVR", **S57_OPEN_OPTIONS)
+        coverage = _coverage_of(geometries, meta["columns"].get("CATCOV"))
+    dsid = _dsid_fields(path)
+    scale = _whole_number(dsid.get("DSPM_CSCL"))
+    return dataclasses.replace(
+        features,
+        coverage=coverage,
+        purpose=_whole_number(dsid.get("DSID_INTU")) or 0,
+        scale=float(scale) if scale else math.inf,
+    )
+
+
+def _coverage_of(geometries: NDArray[np.object_], catcov: Any) -> Any:
+    """The union of the CATCOV 1 ("coverage available") areas less the CATCOV 2 ones; None
+    when there are none."""
+    polygonal = np.isin(shapely.get_type_id(geometries), _POLYGONAL)
+    codes = np.ones(len(geometries)) if catcov is None else _numeric(catcov, Path(), "CATCOV")
+    codes = np.where(np.isnan(codes), 1.0, codes)
+    covered = geometries[polygonal & (codes == 1.0)]
+    if len(covered) == 0:
+        return None
+    uncovered = geometries[polygonal & (codes == 2.0)]
+    return shapely.difference(shapely.union_all(covered), shapely.union_all(uncovered))
+
+
+def _whole_number(value: Any) -> int | None:
+    return int(value) if value is not None and str(value).strip().isdigit() else None
+
+
+def _dsid_fields(path: Path) -> dict[str, Any]:
+    """The DSID record of an S-57 cell (after its updates), or nothing when GDAL has none."""
+    try:
+        meta, _, _, values = pyogrio.raw.read(
+            path, layer="DSID", read_geometry=False, **S57_OPEN_OPTIONS
+        )
+    except (DataSourceError, DataLayerError, FieldError, RuntimeError):
+        return {}
+    return {
+        name: column[0] for name, column in zip(meta["fields"], values, strict=True) if len(column)
+    }
 
 
 def _read_vector(path: Path) -> _Features:
+    """A GeoJSON/GeoPackage chart with S-57 attribute names. Features of class M_COVR (with
+    CATCOV) give its coverage, and their INTU (navigational purpose) and CSCL (compilation
+    scale) its level of detail, as a cell's DSID would."""
     parts: list[tuple[NDArray[np.object_], str | NDArray[np.object_], Mapping[str, Any]]] = []
+    coverage_parts: list[Any] = []
+    detail: dict[str, float] = {}
     for layer in _list_layers(path):
         meta, geometries = _read_layer(path, layer)
         columns = meta["columns"]
@@ -325,7 +377,31 @@ def _read_vector(path: Path) -> _Features:
         geometries = _to_wgs84(geometries, meta["crs"], path)
         classes = np.asarray([_object_class(v, path) for v in columns["OBJL"]], dtype=object)
         parts.append((geometries, classes, columns))
-    return _assemble(path, parts)
+        is_coverage = np.asarray(
+            [str(v).strip().upper() in ("M_COVR", "302") for v in columns["OBJL"]], dtype=bool
+        )
+        if is_coverage.any():
+            catcov = columns.get("CATCOV")
+            coverage_parts.append(
+                _coverage_of(
+                    geometries[is_coverage], None if catcov is None else catcov[is_coverage]
+                )
+            )
+            for name, column in (("INTU", "purpose"), ("CSCL", "scale")):
+                if name in columns:
+                    values = _numeric(columns[name][is_coverage], path, name)
+                    if np.isfinite(values).any():
+                        detail[column] = float(
+                            np.nanmax(values) if column == "purpose" else np.nanmin(values)
+                        )
+    features = _assemble(path, parts)
+    known = [c for c in coverage_parts if c is not None]
+    return dataclasses.replace(
+        features,
+        coverage=shapely.union_all(known) if known else None,
+        purpose=int(detail.get("purpose", 0)),
+        scale=detail.get("scale", math.inf),
+    )
 
 
 def _to_wgs84(geometries: NDArray[np.object_], crs: str | None, path: Path) -> Any:
@@ -451,25 +527,13 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
             "and silently skip the rest. Put the missing update files beside the cell, or "
             "pass --accept-chart-gaps to use the cell as updated up to the gap"
         )
-    fields: dict[str, Any] = {}
-    try:
-        meta, _, _, values = pyogrio.raw.read(
-            path, layer="DSID", read_geometry=False, **S57_OPEN_OPTIONS
-        )
-        fields = {name: column[0] for name, column in zip(meta["fields"], values, strict=True)}
-    except (DataSourceError, DataLayerError, FieldError, RuntimeError, IndexError):
-        fields = {}
-
-    def number(name: str) -> int | None:
-        value = fields.get(name)
-        return int(value) if value is not None and str(value).strip().isdigit() else None
-
+    fields = _dsid_fields(path)
     issue = fields.get("DSID_ISDT")
     return CellInfo(
         path=path,
         name=str(fields.get("DSID_DSNM") or path.name),
-        edition=number("DSID_EDTN"),
-        update_number=number("DSID_UPDN"),
+        edition=_whole_number(fields.get("DSID_EDTN")),
+        update_number=_whole_number(fields.get("DSID_UPDN")),
         issue_date=None if not issue else str(issue),
         update_files=tuple(updates),
         missing_updates=tuple(missing),
@@ -526,16 +590,63 @@ def load_chart(
     return project_charts(read_charts(paths, accept_gaps), frame)
 
 
+def _by_detail(features: Sequence[_Features]) -> list[_Features]:
+    """Most detailed first: higher navigational purpose, then larger compilation scale
+    (smaller denominator), then the order given."""
+    order = sorted(range(len(features)), key=lambda i: (-features[i].purpose, features[i].scale, i))
+    return [features[i] for i in order]
+
+
+def _file_coverage(features: _Features, geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
+    """A file's coverage in the frame: its M_COVR, else the union of its areas
+    (``geometries``: its features in the frame)."""
+    if features.coverage is not None:
+        return _project(np.array([features.coverage], dtype=object), frame)[0]
+    role = np.asarray([_OBJECT_CLASSES[c][1] for c in features.object_class], dtype=object)
+    areal = np.isin(role, [ChartLayer.DEPARE, ChartLayer.DRGARE, ChartLayer.LNDARE]) & np.isin(
+        shapely.get_type_id(geometries), _POLYGONAL
+    )
+    return shapely.union_all(geometries[areal])
+
+
+def _claimed_by_detail(
+    features: Sequence[_Features], frame: LocalFrame
+) -> tuple[list[NDArray[np.object_]], list[Any]]:
+    """Each file's projected geometries, cut to where no more detailed file has coverage (a
+    coarse cell decides only outside the detailed one), and each file's coverage left."""
+    projected = [_project(f.geometries, frame) for f in features]
+    coverages = [_file_coverage(f, g, frame) for f, g in zip(features, projected, strict=True)]
+    if len(features) == 1:
+        return projected, coverages
+    claimed = shapely.Polygon()
+    kept_geometries, kept_coverages = [], []
+    for geometries, coverage in zip(projected, coverages, strict=True):
+        own = shapely.difference(coverage, claimed)
+        clipped = shapely.intersection(geometries, own)
+        kept_geometries.append(clipped)
+        kept_coverages.append(own)
+        claimed = shapely.union(claimed, coverage)
+    return kept_geometries, kept_coverages
+
+
 def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Chart:
-    """Merge charts already read and project them into ``frame`` (default: their extent)."""
-    features = source.features
+    """Merge charts already read and project them into ``frame`` (default: their extent).
+
+    Where charts overlap, the most detailed one decides (``_by_detail``): a union of the
+    deep areas of two cells would take the deeper of two disagreeing soundings.
+    """
+    features = _by_detail(source.features)
     if frame is None:
         frame = LocalFrame.centred_on(*source.bounds_wgs84())
-    geometries = _project(np.concatenate([f.geometries for f in features]), frame)
+    per_file, coverages = _claimed_by_detail(features, frame)
+    geometries = np.concatenate(per_file)
     object_class = np.concatenate([f.object_class for f in features])
     drval1 = np.concatenate([f.drval1_m for f in features])
     drval2 = np.concatenate([f.drval2_m for f in features])
     valsou = np.concatenate([f.valsou_m for f in features])
+    present = ~shapely.is_empty(geometries)
+    geometries, object_class = geometries[present], object_class[present]
+    drval1, drval2, valsou = drval1[present], drval2[present], valsou[present]
     role = np.asarray([_OBJECT_CLASSES[c][1] for c in object_class], dtype=object)
     polygonal = np.isin(shapely.get_type_id(geometries), _POLYGONAL)
 
@@ -548,7 +659,7 @@ def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Char
     hazard_areas = shapely.buffer(geometries[hazard], HAZARD_RADIUS_M)
 
     land = shapely.union_all(geometries[land_areas])
-    coverage = shapely.union_all(np.concatenate([geometries[depth], [land]]))
+    coverage = shapely.union_all(np.asarray(coverages, dtype=object))
     counts: dict[str, int] = {}
     for name in object_class:
         counts[str(name)] = counts.get(str(name), 0) + 1
