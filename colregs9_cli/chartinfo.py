@@ -5,20 +5,73 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
 matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
+import numpy as np
+import pyogrio
+import shapely
 
 from .chart import CellInfo, Chart, load_chart
 from .errors import ParameterError
 from .progress import progress_bar, progress_enabled
-from .report.atomic import save_figure
+from .report.atomic import atomic_path, save_figure
 from .report.chart_plot import draw_chart
 
 DEFAULT_REPORTS_DIR = Path("reports")
+GEOPACKAGE_LAYERS = ("depth_areas", "coverage", "land", "navigable_water")
+
+
+def write_chart_geopackage(path: Path, chart: Chart, draught_m: float, ukc_m: float) -> None:
+    """The chart as a GeoPackage in WGS84 (EPSG:4326), written with GDAL through pyogrio,
+    whole or not at all: ``depth_areas`` (with DRVAL1, DRVAL2 and the S-57 class),
+    ``coverage``, ``land`` and ``navigable_water`` (for the draught and UKC), so that an
+    analyst can check in QGIS the water a verdict used."""
+
+    def to_wgs84(xy: np.ndarray) -> np.ndarray:
+        lat_deg, lon_deg = chart.frame.to_geodetic(xy[:, 1], xy[:, 0])
+        return np.column_stack([lon_deg, lat_deg])
+
+    def geometries(values: Any) -> np.ndarray:
+        projected = shapely.transform(np.atleast_1d(np.asarray(values, dtype=object)), to_wgs84)
+        return np.asarray(shapely.to_wkb(projected), dtype=object)
+
+    water = chart.navigable_water(draught_m, ukc_m)
+    layers = {
+        "depth_areas": (
+            geometries(chart.depth_areas),
+            {
+                "DRVAL1": np.asarray(chart.drval1_m, dtype=float),
+                "DRVAL2": np.asarray(chart.drval2_m, dtype=float),
+                "kind": np.asarray([str(k) for k in chart.kinds], dtype=object),
+            },
+        ),
+        "coverage": (geometries(chart.coverage), {}),
+        "land": (geometries(chart.land), {}),
+        "navigable_water": (
+            geometries(water),
+            {"draught_m": np.array([draught_m]), "ukc_m": np.array([ukc_m])},
+        ),
+    }
+    with atomic_path(path, suffix=".gpkg") as tmp:
+        tmp.unlink()  # GDAL creates the GeoPackage itself
+        for index, (layer, (wkb, fields)) in enumerate(layers.items()):
+            pyogrio.raw.write(
+                tmp,
+                wkb,
+                list(fields.values()),
+                list(fields.keys()),
+                layer=layer,
+                driver="GPKG",
+                geometry_type="MultiPolygon",
+                crs="EPSG:4326",
+                promote_to_multi=True,
+                append=index > 0,
+            )
 
 
 @dataclass(frozen=True)
@@ -83,7 +136,15 @@ def summarise_chart(
     if draught_m is None:
         return ChartSummary(chart, None, None, text)
     area_km2 = chart.navigable_area_km2(draught_m, ukc_m)
-    plot_path = DEFAULT_REPORTS_DIR / f"chart-{Path(paths[0]).stem}.png" if out is None else out
+    out_path = DEFAULT_REPORTS_DIR / f"chart-{Path(paths[0]).stem}.png" if out is None else out
+    if out_path.suffix.lower() == ".gpkg":
+        write_chart_geopackage(out_path, chart, draught_m, ukc_m)
+        text += (
+            f"Navigable water for draught {draught_m:g} m + UKC {ukc_m:g} m: {area_km2:.3f} km²\n"
+        )
+        text += f"GeoPackage: {out_path} (layers {', '.join(GEOPACKAGE_LAYERS)})\n"
+        return ChartSummary(chart, area_km2, out_path, text)
+    plot_path = out_path
     figure, ax = plt.subplots(figsize=(8, 8), layout="constrained")
     try:
         depths = draw_chart(ax, chart, draught_m, ukc_m)

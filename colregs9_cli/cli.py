@@ -346,8 +346,9 @@ def chart_command(
         Path | None,
         typer.Option(
             "--out",
-            metavar="FILE.png",
-            help="Plot file (with --draught); reports/chart-<stem>.png.",
+            metavar="FILE.png|FILE.gpkg",
+            help="With --draught: the plot (.png; default reports/chart-<stem>.png) or a "
+            "GeoPackage in WGS84 with the depth areas, coverage, land and navigable water (.gpkg).",
         ),
     ] = None,
     accept_chart_gaps: Annotated[

@@ -20,14 +20,15 @@ from ..errors import OutputError
 
 
 @contextmanager
-def atomic_path(target: Path) -> Iterator[Path]:
+def atomic_path(target: Path, suffix: str = ".tmp") -> Iterator[Path]:
     """Yield a temporary path in the target's directory; rename it to ``target`` on success.
 
     The temporary file is created with mode 0666 less the umask, as ``open`` would create
-    the target itself (``tempfile.mkstemp`` would make it 0600 whatever the umask).
+    the target itself (``tempfile.mkstemp`` would make it 0600 whatever the umask). ``suffix``
+    ends its name, for writers that go by it (GDAL wants ``.gpkg``).
     """
     target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = _new_file(target.parent, f".{target.name}.", ".tmp")
+    tmp = _new_file(target.parent, f".{target.name}.", suffix)
     try:
         yield tmp
         os.replace(tmp, target)
