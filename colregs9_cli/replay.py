@@ -52,7 +52,7 @@ from .audit import (
     negated,
     passage,
 )
-from .chart import Chart, project_charts, read_charts
+from .chart import Chart, ChartSource, project_charts, read_charts
 from .colregs import (
     ColregsEvaluation,
     Kinematics,
@@ -128,16 +128,22 @@ def run_params(
     )
 
 
-def run_frame(query: Query, positions: pd.DataFrame) -> LocalFrame:
-    """The query region's frame, or one centred on the data when there is none.
+def run_frame(
+    query: Query, positions: pd.DataFrame, chart: ChartSource | None = None
+) -> LocalFrame:
+    """The query region's frame; without one, a frame centred on the charts (where the
+    manoeuvrability estimate is made), else on the data.
 
     The frame carries the chart, the manoeuvrability estimate and the figures; the geometry
-    between vessels never uses it (``encounters.py``). Its central meridian is the circular
-    mean of the longitudes, so that data across the antimeridian is centred on it.
+    between vessels never uses it (``encounters.py``). Centred on the data, its central
+    meridian is the circular mean of the longitudes, so that data across the antimeridian is
+    centred on it.
     """
     frame = query.frame()
     if frame is not None:
         return frame
+    if chart is not None:
+        return LocalFrame.centred_on(*chart.bounds_wgs84())
     lon_rad = np.radians(positions["lon_deg"].to_numpy(dtype=float))
     lon0 = float(np.degrees(np.arctan2(np.sin(lon_rad).mean(), np.cos(lon_rad).mean())))
     lat = positions["lat_deg"]
@@ -756,17 +762,13 @@ def _no_overlap(chart_paths: Sequence[Path], positions: pd.DataFrame) -> ChartEr
 
 
 def load_run_chart(
-    chart_paths: Sequence[Path],
-    frame: LocalFrame,
-    positions: pd.DataFrame,
-    accept_gaps: bool = False,
+    source: ChartSource, chart_paths: Sequence[Path], frame: LocalFrame, positions: pd.DataFrame
 ) -> Chart:
-    """The charts in the run's frame; a chart that covers none of the AIS is an error, and so
-    is a gap in an S-57 cell's update sequence unless ``accept_gaps``.
+    """The charts read (``chart.read_charts``) in the run's frame; a chart that covers none of
+    the AIS is an error.
 
     The boxes are compared first, so that a chart far away is never projected into the frame.
     """
-    source = read_charts(chart_paths, accept_gaps)
     lat_min, lat_max, lon_min, lon_max = source.bounds_wgs84()
     lat = positions["lat_deg"].to_numpy(dtype=float)
     lon = positions["lon_deg"].to_numpy(dtype=float)
@@ -841,10 +843,11 @@ def run_replay(
             f"'{query.name}' holds {vessels_in_data} vessel(s); an encounter needs two. "
             "Widen the query or give more AIS"
         )
-    frame = run_frame(query, positions)
+    source = read_charts(chart_paths, accept_chart_gaps) if chart_paths else None
+    frame = run_frame(query, positions, source)
     chart: Chart | None = None
-    if chart_paths:
-        chart = load_run_chart(chart_paths, frame, positions, accept_chart_gaps)
+    if source is not None:
+        chart = load_run_chart(source, chart_paths, frame, positions)
 
     tracks = build_tracks(positions, frame, params.replay, params.colregs.course_source)
     ledger = _ledger_with_tracks(data.ledger, tracks)
