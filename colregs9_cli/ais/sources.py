@@ -1,6 +1,8 @@
-"""Opening AIS input files: plain, gzip or zip (one data file inside), hashed while read.
+"""Opening AIS input files: plain, gzip, bzip2, xz, zstd or zip (one data file inside), hashed
+while read.
 
-The compression is told by the file's first bytes, not its name. A zip must hold exactly
+The compression is told by the file's first bytes, not its name; every kind is read as a
+stream (the standard library's gzip, bz2 and lzma, pyarrow's zstd codec). A zip must hold exactly
 one CSV (DMA ships one per zip); a zip without a CSV may hold exactly one other file (an
 NMEA log). The sha256 is of the file as stored (the .gz or .zip itself) and is computed
 while the data is read, so a multi-GB file is read from disk once. Decompression failures
@@ -9,9 +11,11 @@ while the data is read, so a multi-GB file is read from disk once. Decompression
 
 from __future__ import annotations
 
+import bz2
 import gzip
 import hashlib
 import io
+import lzma
 import zipfile
 import zlib
 from collections.abc import Iterator
@@ -21,16 +25,33 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import BinaryIO
 
+import pyarrow as pa
+
 from ..errors import InputFileError
 from ..progress import ProgressSink
 
 GZIP_MAGIC = b"\x1f\x8b"
 ZIP_MAGIC = b"PK\x03\x04"
+# Stream compressions by their magic bytes.
+STREAM_MAGIC = {
+    GZIP_MAGIC: "gzip",
+    b"BZh": "bzip2",
+    b"\xfd7zXZ\x00": "xz",
+    b"\x28\xb5\x2f\xfd": "zstd",
+}
 PARQUET_MAGIC = b"PAR1"
 _CHUNK = 1 << 20
 # The head read for layout detection; a DMA header line is about 300 bytes.
 HEAD_BYTES = 64 * 1024
-_DECOMPRESSION_ERRORS = (EOFError, zlib.error, gzip.BadGzipFile, zipfile.BadZipFile, OSError)
+_DECOMPRESSION_ERRORS = (
+    EOFError,
+    zlib.error,
+    gzip.BadGzipFile,
+    zipfile.BadZipFile,
+    lzma.LZMAError,
+    pa.ArrowException,
+    OSError,
+)
 
 
 @dataclass(frozen=True)
@@ -38,7 +59,7 @@ class Source:
     """An input file and how its data is stored."""
 
     path: Path
-    compression: str  # "none", "gzip" or "zip"
+    compression: str  # "none", "zip" or a STREAM_MAGIC kind ("gzip", "bzip2", "xz", "zstd")
     member: str | None  # the data file inside a zip
     size_bytes: int
 
@@ -59,10 +80,11 @@ def inspect_source(path: Path) -> Source:
     if size == 0:
         raise InputFileError(f"{path}: the file is empty; give a file with AIS data")
     with path.open("rb") as handle:
-        magic = handle.read(4)
-    if magic.startswith(GZIP_MAGIC):
-        return Source(path, "gzip", None, size)
-    if magic == ZIP_MAGIC:
+        magic = handle.read(8)
+    for prefix, kind in STREAM_MAGIC.items():
+        if magic.startswith(prefix):
+            return Source(path, kind, None, size)
+    if magic.startswith(ZIP_MAGIC):
         return Source(path, "zip", _zip_member(path), size)
     return Source(path, "none", None, size)
 
@@ -191,20 +213,30 @@ def open_data(source: Source, progress: ProgressSink | None = None) -> Iterator[
             hasher = hashlib.sha256()
             with _CountingReader(raw, hasher, sink) as counting:
                 buffered = io.BufferedReader(counting, _CHUNK)
-                stream: BinaryIO = (
-                    gzip.GzipFile(fileobj=buffered, mode="rb")  # type: ignore[assignment]
-                    if source.compression == "gzip"
-                    else buffered
+                yield OpenedData(
+                    _decompressed(buffered, source.compression), counting, hasher, source.path
                 )
-                yield OpenedData(stream, counting, hasher, source.path)
     except InputFileError:
         raise
     except _DECOMPRESSION_ERRORS as exc:
         raise decompression_error(source, exc) from None
 
 
+def _decompressed(buffered: BinaryIO, compression: str) -> BinaryIO:
+    """The decompressed stream over the stored bytes."""
+    if compression == "gzip":
+        return gzip.GzipFile(fileobj=buffered, mode="rb")  # type: ignore[return-value]
+    if compression == "bzip2":
+        return bz2.BZ2File(buffered, mode="rb")  # type: ignore[return-value]
+    if compression == "xz":
+        return lzma.LZMAFile(buffered, mode="rb")  # type: ignore[return-value]
+    if compression == "zstd":
+        return pa.CompressedInputStream(buffered, "zstd")  # type: ignore[return-value]
+    return buffered  # type: ignore[return-value]
+
+
 def decompression_error(source: Source, exc: BaseException) -> InputFileError:
-    kind = {"gzip": "gzip", "zip": "zip"}.get(source.compression, "file")
+    kind = source.compression if source.compression != "none" else "file"
     return InputFileError(
         f"{source.name}: truncated or corrupt {kind} ({exc}); download or copy the file again"
     )
