@@ -77,3 +77,30 @@ def test_no_audit_fact_on_data_that_stops(sandiego) -> None:
         assert set(pairs.loc[stops, column]) <= {"insufficient-data", ""}, column
     covered = pairs[~stops]
     assert (covered["actual_min_separation_m"].astype(float) > 0).all()
+
+
+def test_report_geopackage_opens_with_every_layer(sandiego) -> None:
+    import numpy as np
+    import pyogrio
+    import shapely
+
+    path = sandiego.out_dir / "report.gpkg"
+    layers = {str(name) for name, _ in pyogrio.list_layers(path)}
+    assert layers == {"encounters", "tracks", "cpa", "domains", "navigable_water"}
+    for layer in layers:
+        info = pyogrio.read_info(path, layer=layer)
+        assert info["crs"] == "EPSG:4326" and info["features"] > 0, layer
+    # one point per vessel and encounter row, at the trigger positions of encounters.csv
+    meta, _, wkb, fields = pyogrio.raw.read(path, layer="encounters")
+    columns = dict(zip(meta["fields"], fields, strict=True))
+    assert len(wkb) == 2 * TRIGGERED_SEATS
+    assert set(meta["fields"]) >= set(_table(sandiego, "encounters.csv").columns)
+    points = shapely.from_wkb(wkb)
+    own = np.asarray(columns["vessel"]) == "own"
+    np.testing.assert_allclose(
+        shapely.get_y(points[own]),
+        np.asarray(columns["own_lat_deg_at_trigger"])[own].astype(float),
+        atol=1e-7,
+    )
+    domains = pyogrio.read_info(path, layer="domains")
+    assert {"restricted", "covered", "arc", "step"} <= set(domains["fields"])

@@ -33,6 +33,7 @@ from ..replay_results import (
 )
 from .atomic import report_directory, save_figure, write_csv, write_json, write_text
 from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart
+from .replay_geopackage import GEOPACKAGE_NAME, write_replay_geopackage
 
 if TYPE_CHECKING:
     from ..chart import Chart
@@ -468,7 +469,11 @@ def _write_replay_files(
                 plt.close(figure)
         progress.advance()
     encounters_csv = out_dir / ENCOUNTERS_NAME
-    write_csv(encounters_csv, _lowercase_booleans(encounters_frame(result.encounters)))
+    encounters_table = _lowercase_booleans(encounters_frame(result.encounters))
+    write_csv(encounters_csv, encounters_table)
+    geopackage = write_replay_geopackage(out_dir / GEOPACKAGE_NAME, result, encounters_table, chart)
+    if geopackage is not None:
+        files.append(geopackage)
     pairs_csv = out_dir / PAIRS_NAME
     write_csv(pairs_csv, _lowercase_booleans(pairs_frame(result.pairs)))
     index = out_dir / INDEX_NAME
