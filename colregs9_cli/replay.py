@@ -823,8 +823,10 @@ def run_replay(
     quiet: bool = True,
     overwrite: bool = False,
     accept_chart_gaps: bool = False,
+    write: bool = True,
 ) -> ReplayResult:
-    """Replay ``ais_paths`` and write the reports (see the module docstring).
+    """Replay ``ais_paths`` and write the reports (see the module docstring); with
+    ``write=False`` nothing is written (the result is in memory only).
 
     Errors: an own MMSI not in the data, fewer than two vessels (``NoDataError``, exit 3); a
     chart that covers none of the AIS (``ChartError``, exit 2); bad files or parameters. A run
@@ -833,7 +835,8 @@ def run_replay(
     query = load_query(query_path) if query_path is not None else everything_query()
     params = run_params(query, own_mmsi, overrides)
     target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
-    check_out_dir(target, overwrite)
+    if write:
+        check_out_dir(target, overwrite)
     data = load_ais(ais_paths, query=query, fmt=fmt, quiet=quiet)
     positions = data.positions
     vessels_in_data = positions["mmsi"].nunique()
@@ -872,8 +875,10 @@ def run_replay(
         manifest=manifest,
         files=(),
     )
-    with progress_bar("reports", len(result.encounters), progress_enabled(quiet)) as bar:
-        files = write_replay_reports(result, chart, plots, bar)
+    files: tuple[Path, ...] = ()
+    if write:
+        with progress_bar("reports", len(result.encounters), progress_enabled(quiet)) as bar:
+            files = write_replay_reports(result, chart, plots, bar)
     return dataclasses.replace(result, files=files, text=format_summary(result))
 
 
