@@ -132,7 +132,8 @@ def format_demo(result: DemoResult) -> str:
             f"  {verdict.scenario}",
             f"    figure   {verdict.figure}",
             f"    AIS      {verdict.simulation.out_path}",
-            f"    reports  {verdict.replay.out_dir}/ (encounters.csv, index.md, run.json)",
+            f"    reports  {verdict.replay.out_dir}/ (pairs.csv, encounters.csv, report.gpkg, "
+            "index.md, run.json)",
         ]
     return "\n".join(lines) + "\n"
 
