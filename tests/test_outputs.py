@@ -116,3 +116,29 @@ def test_a_failed_run_leaves_the_old_report(tmp_path: Path) -> None:
         raise RuntimeError("the analysis failed")
     assert sorted(p.name for p in out.iterdir()) == ["run.json"]
     assert [p.name for p in tmp_path.iterdir()] == ["report"]
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["simulate", "SCENARIO", "--out", "OUT/x.csv"],
+        ["swing", "--out", "OUT/swing"],
+        ["chart", "CHART", "--draught", "2", "--out", "OUT/chart.png"],
+        ["demo", "--out", "OUT/demo"],
+    ],
+)
+def test_every_writer_gives_one_error_line_for_an_out_under_a_file(
+    tmp_path: Path, command: list[str]
+) -> None:
+    from fixture_files import SANDIEGO_ENC, SCENARIOS
+
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    replacements = {
+        "SCENARIO": str(SCENARIOS / "greenhopper_restricted.toml"),
+        "CHART": str(SANDIEGO_ENC),
+    }
+    args = [replacements.get(a, a).replace("OUT", str(a_file)) for a in command]
+    result = _invoke(*args, "--quiet") if command[0] != "swing" else _invoke(*args)
+    assert result.exit_code == OutputError.exit_code, result.output
+    assert f"lies under {a_file}, which is a file" in _one_error_line(result.output)

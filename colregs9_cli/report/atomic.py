@@ -27,11 +27,24 @@ def atomic_path(target: Path, suffix: str = ".tmp") -> Iterator[Path]:
     the target itself (``tempfile.mkstemp`` would make it 0600 whatever the umask). ``suffix``
     ends its name, for writers that go by it (GDAL wants ``.gpkg``).
     """
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = _new_file(target.parent, f".{target.name}.", suffix)
+    existing = target.parent
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise OutputError(f"{target}: lies under {existing}, which is a file; give another --out")
+    try:
+        if target.is_dir():
+            raise IsADirectoryError(21, "a directory is in the way", str(target))
+        target.parent.mkdir(parents=True, exist_ok=True)
+        tmp = _new_file(target.parent, f".{target.name}.", suffix)
+    except OSError as exc:
+        raise _output_error(target, exc) from None
     try:
         yield tmp
-        os.replace(tmp, target)
+        try:
+            os.replace(tmp, target)
+        except OSError as exc:
+            raise _output_error(target, exc) from None
     finally:
         if tmp.exists():
             tmp.unlink()
@@ -121,11 +134,11 @@ def report_directory(out_dir: Path) -> Iterator[Path]:
             shutil.rmtree(staging, ignore_errors=True)
 
 
-def _output_error(out_dir: Path, exc: OSError) -> OutputError:
-    where = exc.filename if exc.filename else out_dir
+def _output_error(out: Path, exc: OSError) -> OutputError:
+    where = exc.filename if exc.filename else out
     return OutputError(
-        f"{out_dir}: cannot write the report ({exc.strerror or exc} at {where}); check the "
-        "free space and permissions, or give another --out"
+        f"{out}: cannot write it ({exc.strerror or exc} at {where}); check the path, the free "
+        "space and the permissions, or give another --out"
     )
 
 
