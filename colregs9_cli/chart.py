@@ -23,8 +23,23 @@ sounding (unknown depth is treated as dangerous, as ECDIS does).
 
 Navigable water for draught T is the union of depth areas with ``DRVAL1 >= T + UKC``, minus
 land and structures, with gaps narrower than ``SLIVER_TOLERANCE_M`` closed (see there), minus
-the blocking hazards. Coverage (the charted extent) is the union of every depth area, land and
-structure: a position outside it is "unknown", never "deep".
+the blocking hazards.
+
+Coverage (the charted extent) is what a chart says it covers: its M_COVR areas with CATCOV 1
+less those with CATCOV 2 (an S-57 cell's ``M_COVR`` layer, or features of class M_COVR in a
+GeoJSON/GeoPackage); a chart without them covers the union of its depth areas, land and
+structures. A position outside it is "unknown", never "deep", and so is a ship domain that
+is not wholly inside it (``Chart.covers_shapes``).
+
+Several charts are ranked most detailed first (``_by_detail``): the higher navigational
+purpose (DSID INTU, else the digit in an S-57 cell name's third character; for GeoJSON/
+GeoPackage an ``INTU`` property on its M_COVR features or a DSID table), then the larger
+compilation scale (DSPM CSCL; ``CSCL`` on M_COVR), then the order given. Each chart decides
+only where no more detailed one covers: its features are clipped to its coverage less theirs.
+
+An S-57 cell's update files are checked before it is read (``s57_cell_info``): a gap in their
+sequence is a ``ChartError`` unless accepted, and each cell's edition, update number, issue
+date, purpose and scale are kept in ``CellInfo``.
 """
 
 from __future__ import annotations
@@ -101,7 +116,10 @@ class Chart:
 
     ``hazard_areas``/``hazard_depth_m`` hold each buffered hazard and its sounding (NaN when
     unknown); ``hazards`` is their union. A chart built without the per-hazard arrays treats
-    every hazard as blocking.
+    every hazard as blocking. ``detail_order`` lists the chart files most detailed first: where
+    they overlap, the first one covering a place decides its depths; ``coverage_by_chart`` is
+    the part of the coverage each of them decides, and ``depth_chart`` the index (into
+    ``detail_order``) of the file each depth area comes from.
     """
 
     frame: LocalFrame
@@ -114,6 +132,9 @@ class Chart:
     coverage: Any
     sources: tuple[Path, ...] = ()
     cells: tuple[CellInfo, ...] = ()
+    detail_order: tuple[Path, ...] = ()
+    coverage_by_chart: tuple[Any, ...] = ()
+    depth_chart: NDArray[np.int64] = field(default_factory=lambda: np.empty(0, dtype=np.int64))
     layer_counts: Mapping[str, int] = field(default_factory=dict)
     hazard_areas: NDArray[np.object_] = field(default_factory=lambda: np.empty(0, dtype=object))
     hazard_depth_m: NDArray[np.float64] = field(default_factory=lambda: np.empty(0))
@@ -168,8 +189,9 @@ class Chart:
     def covers_shapes(
         self, north_m: NDArray[np.float64], east_m: NDArray[np.float64], shapes: Any, reach_m: float
     ) -> NDArray[np.bool_]:
-        """True where a shape lies wholly inside the charted extent: the edge of a chart is not
-        the edge of the water. ``shapes`` is called with the indices of the positions within
+        """True where a shape lies wholly inside the charted extent, not touching its edge: the
+        edge of a chart is not the edge of the water, so a shape that touches or crosses it is
+        neither red nor blue. ``shapes`` is called with the indices of the positions within
         ``reach_m`` (the shapes' largest extent from their position) of the extent's boundary
         and returns their polygons; the others are decided by their position alone."""
         covered = self.covers(north_m, east_m)
@@ -185,7 +207,7 @@ class Chart:
             )
         )
         if len(near):
-            covered[near] = shapely.contains(self.coverage, shapes(near))
+            covered[near] = shapely.contains_properly(self.coverage, shapes(near))
         return covered
 
     def covers_disk(self, north_m: float, east_m: float, radius_m: float) -> bool:
@@ -193,6 +215,11 @@ class Chart:
         return bool(self.covers(north_m, east_m)[0]) and not bool(
             shapely.dwithin(self._coverage_boundary, shapely.Point(east_m, north_m), radius_m)
         )
+
+    @property
+    def update_gaps(self) -> dict[str, tuple[str, ...]]:
+        """The update files missing from each cell read with a gap accepted, by cell name."""
+        return {cell.name: cell.missing_updates for cell in self.cells if cell.missing_updates}
 
     def navigable_area_km2(self, draught_m: float, ukc_m: float = 0.0) -> float:
         return float(shapely.area(self.navigable_water(draught_m, ukc_m))) / 1e6
@@ -321,9 +348,19 @@ def _read_s57(path: Path) -> _Features:
     return dataclasses.replace(
         features,
         coverage=coverage,
-        purpose=_whole_number(dsid.get("DSID_INTU")) or 0,
+        purpose=cell_purpose(dsid.get("DSID_INTU"), path),
         scale=float(scale) if scale else math.inf,
     )
+
+
+def cell_purpose(intu: Any, path: Path) -> int:
+    """A cell's navigational purpose, 1 (overview) … 6 (berthing): DSID INTU, else the digit
+    in the third character of its name (``US5CA72M``: 5, harbour), else 0 (unknown)."""
+    purpose = _whole_number(intu)
+    if purpose is not None and 1 <= purpose <= 6:
+        return purpose
+    digit = Path(path).name[2:3]
+    return int(digit) if digit.isdigit() and 1 <= int(digit) <= 6 else 0
 
 
 def _coverage_of(geometries: NDArray[np.object_], catcov: Any) -> Any:
@@ -359,26 +396,43 @@ def _dsid_fields(path: Path) -> dict[str, Any]:
 def _read_vector(path: Path) -> _Features:
     """A GeoJSON/GeoPackage chart with S-57 attribute names. Features of class M_COVR (with
     CATCOV) give its coverage, and their INTU (navigational purpose) and CSCL (compilation
-    scale) its level of detail, as a cell's DSID would."""
+    scale) its level of detail, as a cell's DSID would.
+
+    A layer without an OBJL column takes its class from its name (``DEPARE``, ``M_COVR`` …),
+    and a table named DSID with DSID_INTU and DSPM_CSCL gives the level of detail: the layout
+    ``ogr2ogr -f GPKG out.gpkg CELL.000`` writes. DRVAL1 is needed where there are depth areas.
+    """
     parts: list[tuple[NDArray[np.object_], str | NDArray[np.object_], Mapping[str, Any]]] = []
     coverage_parts: list[Any] = []
     detail: dict[str, float] = {}
     for layer in _list_layers(path):
         meta, geometries = _read_layer(path, layer)
         columns = meta["columns"]
+        if layer.upper() == "DSID":
+            _dsid_detail(columns, detail)
+            continue
         if len(geometries) == 0:
             continue
-        for column in ("OBJL", "DRVAL1"):
-            if column not in columns:
+        objl = columns.get("OBJL")
+        if objl is None:
+            if not _is_class_name(layer):
                 raise ChartError(
-                    f"{path}: layer {layer} has no column {column}; a GeoJSON/GeoPackage chart "
-                    "needs OBJL (S-57 object class, e.g. DEPARE) and DRVAL1 (shallowest depth, m)"
+                    f"{path}: layer {layer} has no column OBJL; a GeoJSON/GeoPackage chart needs "
+                    "OBJL (S-57 object class, e.g. DEPARE) and DRVAL1 (shallowest depth, m), or "
+                    "layers named after their S-57 object class"
                 )
+            objl = np.full(len(geometries), layer.upper(), dtype=object)
+        classes = np.asarray([_object_class(v, path) for v in objl], dtype=object)
+        if "DRVAL1" not in columns and np.isin(classes, ["DEPARE", "DRGARE"]).any():
+            raise ChartError(
+                f"{path}: layer {layer} has depth areas but no column DRVAL1; a GeoJSON/"
+                "GeoPackage chart needs OBJL (S-57 object class, e.g. DEPARE) and DRVAL1 "
+                "(shallowest depth, m)"
+            )
         geometries = _to_wgs84(geometries, meta["crs"], path)
-        classes = np.asarray([_object_class(v, path) for v in columns["OBJL"]], dtype=object)
         parts.append((geometries, classes, columns))
         is_coverage = np.asarray(
-            [str(v).strip().upper() in ("M_COVR", "302") for v in columns["OBJL"]], dtype=bool
+            [str(v).strip().upper() in ("M_COVR", "302") for v in objl], dtype=bool
         )
         if is_coverage.any():
             catcov = columns.get("CATCOV")
@@ -402,6 +456,19 @@ def _read_vector(path: Path) -> _Features:
         purpose=int(detail.get("purpose", 0)),
         scale=detail.get("scale", math.inf),
     )
+
+
+def _is_class_name(layer: str) -> bool:
+    return layer.upper() in _OBJECT_CLASSES or layer.upper() == "M_COVR"
+
+
+def _dsid_detail(columns: Mapping[str, Any], detail: dict[str, float]) -> None:
+    """Navigational purpose and compilation scale from a DSID table (S-57 field names)."""
+    for name, key in (("DSID_INTU", "purpose"), ("DSPM_CSCL", "scale")):
+        values = columns.get(name)
+        number = _whole_number(values[0]) if values is not None and len(values) else None
+        if number:
+            detail[key] = float(number)
 
 
 def _to_wgs84(geometries: NDArray[np.object_], crs: str | None, path: Path) -> Any:
@@ -489,6 +556,7 @@ class CellInfo:
     ``update_files`` are the update files beside the base cell, in order; ``missing_updates``
     names the files missing from that sequence, when the user accepted the gap (GDAL then
     applies the updates before the gap and none after it: ``update_number`` tells which).
+    ``purpose`` and ``scale`` rank the cell where charts overlap (``project_charts``).
     """
 
     path: Path
@@ -498,6 +566,8 @@ class CellInfo:
     issue_date: str | None
     update_files: tuple[Path, ...]
     missing_updates: tuple[str, ...]
+    purpose: int = 0  # navigational purpose (``cell_purpose``); 0 unknown
+    scale: int | None = None  # compilation scale denominator (DSPM CSCL)
 
 
 def _update_files(path: Path) -> tuple[list[Path], list[str]]:
@@ -537,6 +607,8 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
         issue_date=None if not issue else str(issue),
         update_files=tuple(updates),
         missing_updates=tuple(missing),
+        purpose=cell_purpose(fields.get("DSID_INTU"), path),
+        scale=_whole_number(fields.get("DSPM_CSCL")),
     )
 
 
@@ -549,10 +621,19 @@ class ChartSource:
     features: tuple[_Features, ...]
     cells: tuple[CellInfo, ...] = ()
 
+    @property
+    def update_gaps(self) -> dict[str, tuple[str, ...]]:
+        """The update files missing from each cell read with a gap accepted, by cell name;
+        empty when every update sequence is whole."""
+        return {cell.name: cell.missing_updates for cell in self.cells if cell.missing_updates}
+
     def bounds_wgs84(self) -> tuple[float, float, float, float]:
-        """(lat_min, lat_max, lon_min, lon_max) of the charts' features."""
+        """(lat_min, lat_max, lon_min, lon_max) of the charts' features and coverage."""
+        coverages = np.asarray(
+            [f.coverage for f in self.features if f.coverage is not None], dtype=object
+        )
         lon_min, lat_min, lon_max, lat_max = shapely.total_bounds(
-            np.concatenate([f.geometries for f in self.features])
+            np.concatenate([*(f.geometries for f in self.features), coverages])
         )
         return float(lat_min), float(lat_max), float(lon_min), float(lon_max)
 
@@ -622,11 +703,27 @@ def _claimed_by_detail(
     kept_geometries, kept_coverages = [], []
     for geometries, coverage in zip(projected, coverages, strict=True):
         own = shapely.difference(coverage, claimed)
-        clipped = shapely.intersection(geometries, own)
+        clipped = _same_dimension(shapely.intersection(geometries, own), geometries)
         kept_geometries.append(clipped)
         kept_coverages.append(own)
         claimed = shapely.union(claimed, coverage)
     return kept_geometries, kept_coverages
+
+
+def _same_dimension(clipped: NDArray[np.object_], original: NDArray[np.object_]) -> Any:
+    """``clipped`` with the parts of a lower dimension than the feature's dropped.
+
+    GEOS may return a polygon clipped along an edge of the clip as a geometry collection (the
+    area and a line where they touch): it would no longer count as a depth area at all.
+    """
+    clipped = np.array(clipped, dtype=object)
+    mixed = np.flatnonzero(shapely.get_type_id(clipped) == shapely.GeometryType.GEOMETRYCOLLECTION)
+    for i in mixed:
+        dimension = shapely.get_dimensions(original[i])
+        parts = shapely.get_parts(clipped[i])
+        parts = parts[shapely.get_dimensions(parts) == dimension]
+        clipped[i] = shapely.union_all(parts) if len(parts) else shapely.Polygon()
+    return clipped
 
 
 def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Chart:
@@ -644,9 +741,13 @@ def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Char
     drval1 = np.concatenate([f.drval1_m for f in features])
     drval2 = np.concatenate([f.drval2_m for f in features])
     valsou = np.concatenate([f.valsou_m for f in features])
+    chart_index = np.concatenate(
+        [np.full(len(g), i, dtype=np.int64) for i, g in enumerate(per_file)]
+    )
     present = ~shapely.is_empty(geometries)
     geometries, object_class = geometries[present], object_class[present]
     drval1, drval2, valsou = drval1[present], drval2[present], valsou[present]
+    chart_index = chart_index[present]
     role = np.asarray([_OBJECT_CLASSES[c][1] for c in object_class], dtype=object)
     polygonal = np.isin(shapely.get_type_id(geometries), _POLYGONAL)
 
@@ -674,6 +775,9 @@ def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Char
         coverage=coverage,
         sources=source.paths,
         cells=source.cells,
+        detail_order=tuple(f.path for f in features),
+        coverage_by_chart=tuple(coverages),
+        depth_chart=chart_index[depth],
         layer_counts={name: counts[name] for name in _OBJECT_CLASSES if name in counts},
         hazard_areas=hazard_areas,
         hazard_depth_m=hazard_depth,

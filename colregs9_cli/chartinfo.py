@@ -17,30 +17,63 @@ import pyogrio
 import shapely
 
 from .chart import CellInfo, Chart, load_chart
-from .errors import ParameterError
+from .errors import OutputError, ParameterError
 from .progress import progress_bar, progress_enabled
 from .report.atomic import atomic_path, save_figure
 from .report.chart_plot import draw_chart
 
 DEFAULT_REPORTS_DIR = Path("reports")
 GEOPACKAGE_LAYERS = ("depth_areas", "coverage", "land", "navigable_water")
+GEOPACKAGE_SUFFIX = ".gpkg"
+PLOT_SUFFIXES = (".png", ".svg", ".pdf")
+PURPOSES = {1: "overview", 2: "general", 3: "coastal", 4: "approach", 5: "harbour", 6: "berthing"}
+
+
+def _multipolygons(values: Any) -> np.ndarray:
+    """Each geometry as a MultiPolygon of its polygonal parts (MULTIPOLYGON EMPTY when it has
+    none): a GeoPackage layer of type MultiPolygon takes nothing else."""
+    geometries = np.atleast_1d(np.asarray(values, dtype=object))
+    parts, owner = shapely.get_parts(geometries, return_index=True)
+    keep = (shapely.get_type_id(parts) == shapely.GeometryType.POLYGON) & ~shapely.is_empty(parts)
+    out = np.array([shapely.MultiPolygon() for _ in geometries], dtype=object)
+    if keep.any():
+        # Indices left out keep their value in ``out``: the empty MultiPolygon.
+        shapely.multipolygons(parts[keep], indices=owner[keep], out=out)
+    return out
 
 
 def write_chart_geopackage(path: Path, chart: Chart, draught_m: float, ukc_m: float) -> None:
     """The chart as a GeoPackage in WGS84 (EPSG:4326), written with GDAL through pyogrio,
-    whole or not at all: ``depth_areas`` (with DRVAL1, DRVAL2 and the S-57 class),
-    ``coverage``, ``land`` and ``navigable_water`` (for the draught and UKC), so that an
-    analyst can check in QGIS the water a verdict used."""
+    whole or not at all: ``depth_areas`` (with DRVAL1, DRVAL2, the S-57 class and the chart
+    file it comes from), ``coverage`` (one feature per chart file: the part it decides, with
+    its ``rank``, 1 the most detailed), ``land`` (no feature when the chart has none) and
+    ``navigable_water`` (for the draught and UKC), so that an analyst can check in QGIS the
+    water a verdict used."""
 
     def to_wgs84(xy: np.ndarray) -> np.ndarray:
         lat_deg, lon_deg = chart.frame.to_geodetic(xy[:, 1], xy[:, 0])
         return np.column_stack([lon_deg, lat_deg])
 
     def geometries(values: Any) -> np.ndarray:
-        projected = shapely.transform(np.atleast_1d(np.asarray(values, dtype=object)), to_wgs84)
+        projected = shapely.transform(_multipolygons(values), to_wgs84)
         return np.asarray(shapely.to_wkb(projected), dtype=object)
 
     water = chart.navigable_water(draught_m, ukc_m)
+    names = [p.name for p in chart.detail_order]
+    depth_chart = (
+        np.asarray([names[i] for i in chart.depth_chart], dtype=object)
+        if len(chart.depth_chart) == len(chart.depth_areas)
+        else np.full(len(chart.depth_areas), "", dtype=object)
+    )
+    if chart.coverage_by_chart:
+        coverage_geometries = list(chart.coverage_by_chart)
+        coverage_fields = {
+            "chart": np.asarray(names, dtype=object),
+            "rank": np.arange(1, len(names) + 1, dtype=np.int32),
+        }
+    else:
+        coverage_geometries, coverage_fields = [chart.coverage], {}
+    land = [] if shapely.is_empty(chart.land) else [chart.land]
     layers = {
         "depth_areas": (
             geometries(chart.depth_areas),
@@ -48,10 +81,11 @@ def write_chart_geopackage(path: Path, chart: Chart, draught_m: float, ukc_m: fl
                 "DRVAL1": np.asarray(chart.drval1_m, dtype=float),
                 "DRVAL2": np.asarray(chart.drval2_m, dtype=float),
                 "kind": np.asarray([str(k) for k in chart.kinds], dtype=object),
+                "chart": depth_chart,
             },
         ),
-        "coverage": (geometries(chart.coverage), {}),
-        "land": (geometries(chart.land), {}),
+        "coverage": (geometries(np.asarray(coverage_geometries, dtype=object)), coverage_fields),
+        "land": (geometries(np.asarray(land, dtype=object)), {}),
         "navigable_water": (
             geometries(water),
             {"draught_m": np.array([draught_m]), "ukc_m": np.array([ukc_m])},
@@ -88,15 +122,22 @@ def _check_depth(name: str, value: float | None) -> None:
 
 
 def format_cell(cell: CellInfo) -> str:
-    """One S-57 cell's identity: edition, update number, issue date, accepted gaps."""
+    """One S-57 cell's identity: edition, update number, issue date, navigational purpose,
+    compilation scale, accepted gaps."""
     edition = "?" if cell.edition is None else str(cell.edition)
     update = "?" if cell.update_number is None else str(cell.update_number)
     issued = "" if cell.issue_date is None else f", issued {cell.issue_date}"
+    purpose = (
+        f", purpose {cell.purpose} ({PURPOSES[cell.purpose]})" if cell.purpose in PURPOSES else ""
+    )
+    scale = "" if cell.scale is None else f", scale 1:{cell.scale}"
     files = f"{len(cell.update_files)} update file(s)"
     gap = (
         f"; GAP ACCEPTED, missing {', '.join(cell.missing_updates)}" if cell.missing_updates else ""
     )
-    return f"  {cell.name}: edition {edition}, update {update}{issued} ({files}{gap})"
+    return (
+        f"  {cell.name}: edition {edition}, update {update}{issued}{purpose}{scale} ({files}{gap})"
+    )
 
 
 def format_chart_summary(chart: Chart) -> str:
@@ -105,6 +146,11 @@ def format_chart_summary(chart: Chart) -> str:
     lines = ["Charts: " + ", ".join(str(p) for p in chart.sources)]
     if chart.cells:
         lines += ["S-57 cells:", *(format_cell(cell) for cell in chart.cells)]
+    if len(chart.detail_order) > 1:
+        lines += [
+            "Where they overlap, the first decides: "
+            + " > ".join(p.name for p in chart.detail_order)
+        ]
     lines += ["Layers (features):"]
     lines += [f"  {name:<7} {count:>6}" for name, count in chart.layer_counts.items()]
     lines += [
@@ -113,6 +159,27 @@ def format_chart_summary(chart: Chart) -> str:
         f"Charted area: {chart.coverage.area / 1e6:.3f} km²",
     ]
     return "\n".join(lines) + "\n"
+
+
+def check_chart_out(out: Path | None, draught_m: float | None) -> None:
+    """Refuse, before any chart is read, an ``--out`` the command would not write: one
+    without ``--draught`` (the plot and the GeoPackage show the water for a draught) or of
+    another kind than a plot or a GeoPackage. Paths that cannot be written are refused when
+    writing (``atomic_path``)."""
+    if out is None:
+        return
+    if draught_m is None:
+        raise ParameterError(
+            f"--out {out} needs --draught M: the plot and the GeoPackage show the navigable "
+            "water for a draught; add --draught"
+        )
+    suffix = out.suffix.lower()
+    if suffix != GEOPACKAGE_SUFFIX and suffix not in PLOT_SUFFIXES:
+        raise OutputError(
+            f"{out}: --out ends in {suffix or '(no suffix)'!r}, which the chart command does not "
+            f"write; give FILE.gpkg for a GeoPackage or FILE.png ({', '.join(PLOT_SUFFIXES)}) "
+            "for a plot"
+        )
 
 
 def summarise_chart(
@@ -129,6 +196,7 @@ def summarise_chart(
     """
     _check_depth("draught", draught_m)
     _check_depth("ukc", ukc_m)
+    check_chart_out(out, draught_m)
     with progress_bar("Reading charts", 1, progress_enabled(quiet)) as bar:
         chart = load_chart(paths, accept_gaps=accept_gaps)
         bar.advance()
@@ -137,7 +205,7 @@ def summarise_chart(
         return ChartSummary(chart, None, None, text)
     area_km2 = chart.navigable_area_km2(draught_m, ukc_m)
     out_path = DEFAULT_REPORTS_DIR / f"chart-{Path(paths[0]).stem}.png" if out is None else out
-    if out_path.suffix.lower() == ".gpkg":
+    if out_path.suffix.lower() == GEOPACKAGE_SUFFIX:
         write_chart_geopackage(out_path, chart, draught_m, ukc_m)
         text += (
             f"Navigable water for draught {draught_m:g} m + UKC {ukc_m:g} m: {area_km2:.3f} km²\n"
@@ -147,7 +215,7 @@ def summarise_chart(
     plot_path = out_path
     figure, ax = plt.subplots(figsize=(8, 8), layout="constrained")
     try:
-        depths = draw_chart(ax, chart, draught_m, ukc_m)
+        depths = draw_chart(ax, chart, draught_m, ukc_m, coverage=True)
         figure.colorbar(depths, ax=ax, label="DRVAL1, shallowest depth (m)", shrink=0.7)
         ax.set_xlabel("east (m)")
         ax.set_ylabel("north (m)")

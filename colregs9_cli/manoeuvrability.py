@@ -20,10 +20,10 @@
 
 Unknown chart coverage is three-valued, never "clear": no chart, or the target's present
 position outside the chart, gives ``UNKNOWN``. A projected position is covered only when its
-whole ellipse lies inside the chart's coverage (the edge of a chart is not the edge of the
-water); an uncovered one may be either red or blue. The verdict is ``RESTRICTED`` when the
-policy holds on the covered red positions alone, ``NOT_RESTRICTED`` when it fails even if
-every uncovered position were red, and ``UNKNOWN`` in between.
+whole ellipse lies inside the chart's coverage without touching its edge (the edge of a chart
+is not the edge of the water); an uncovered one may be either red or blue. The verdict is
+``RESTRICTED`` when the policy holds on the covered red positions alone, ``NOT_RESTRICTED``
+when it fails even if every uncovered position were red, and ``UNKNOWN`` in between.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from colregs9_cli.chart import read_charts, s57_cell_info
+from colregs9_cli.chart import project_charts, read_charts, s57_cell_info
 from colregs9_cli.cli import app
 from colregs9_cli.errors import ChartError
 from colregs9_cli.replay import run_replay
@@ -21,8 +21,21 @@ from fixture_files import SANDIEGO_AIS, SANDIEGO_ENC
 def test_the_sandiego_cell_with_both_updates() -> None:
     cell = s57_cell_info(SANDIEGO_ENC)
     assert (cell.edition, cell.update_number, cell.issue_date) == (56, 2, "20250428")
+    assert (cell.purpose, cell.scale) == (5, 12_000)  # harbour, 1:12,000 (DSID)
     assert [p.name for p in cell.update_files] == ["US5CA72M.001", "US5CA72M.002"]
     assert cell.missing_updates == ()
+    assert read_charts([SANDIEGO_ENC]).update_gaps == {}
+
+
+def test_a_gap_in_the_middle_names_the_missing_update(tmp_path: Path) -> None:
+    # .001 and .003 beside the base cell, .002 missing (the San Diego .002 stands in for .003)
+    for source, name in (("000", "000"), ("001", "001"), ("002", "003")):
+        shutil.copyfile(SANDIEGO_ENC.with_suffix(f".{source}"), tmp_path / f"US5CA72M.{name}")
+    with pytest.raises(ChartError, match=r"US5CA72M\.002 missing beside US5CA72M\.001, "):
+        read_charts([tmp_path / "US5CA72M.000"])
+    (cell,) = read_charts([tmp_path / "US5CA72M.000"], accept_gaps=True).cells
+    assert cell.missing_updates == ("US5CA72M.002",)
+    assert cell.update_number == 1  # GDAL applied .001 and stopped at the gap
 
 
 @pytest.fixture()
@@ -39,16 +52,23 @@ def test_a_gap_is_an_error_naming_the_missing_file(gap: Path) -> None:
 
 
 def test_an_accepted_gap_is_the_cell_as_updated_up_to_it(gap: Path) -> None:
-    (cell,) = read_charts([gap], accept_gaps=True).cells
+    source = read_charts([gap], accept_gaps=True)
+    (cell,) = source.cells
     assert cell.missing_updates == ("US5CA72M.001",)
     assert cell.update_number == 0  # nothing after the gap was applied
     assert cell.edition == 56
+    # the acceptance is on the source and the chart, for run.json and the summary
+    assert source.update_gaps == {"US5CA72M.000": ("US5CA72M.001",)}
+    assert project_charts(source).update_gaps == source.update_gaps
 
 
 def test_the_chart_command_prints_the_cell_and_refuses_a_gap(gap: Path) -> None:
     shown = CliRunner().invoke(app, ["chart", str(SANDIEGO_ENC), "--quiet"])
     assert shown.exit_code == 0, shown.output
-    assert "US5CA72M.000: edition 56, update 2, issued 20250428" in shown.output
+    assert (
+        "US5CA72M.000: edition 56, update 2, issued 20250428, purpose 5 (harbour), "
+        "scale 1:12000 (2 update file(s))"
+    ) in shown.output
     refused = CliRunner().invoke(app, ["chart", str(gap), "--quiet"])
     assert refused.exit_code == ChartError.exit_code
     lines = [line for line in refused.output.splitlines() if line.strip()]

@@ -5,6 +5,12 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -97,3 +103,51 @@ def test_alpha_outside_zero_one(tmp_path: Path) -> None:
     ais = FIXTURES / "ais" / "aisdk_2024-09-09_sample.csv"
     result = _run("replay", str(ais), "--alpha", "1.5", "--no-plots", "--out", str(tmp_path))
     _one_error_line(result, "alpha 1.5 is outside [0, 1]")
+
+
+@pytest.mark.parametrize("name", ["chart.txt", "chart", "chart.shp"])
+def test_an_out_of_another_kind_is_refused(tmp_path: Path, name: str) -> None:
+    out = tmp_path / name
+    result = _run("chart", str(ENC), "--draught", "5", "--out", str(out), "--quiet")
+    _one_error_line(result, name, ".gpkg", ".png")
+    assert result.exit_code == 2
+    assert list(tmp_path.iterdir()) == []  # nothing written, not even a temporary file
+
+
+@pytest.mark.parametrize("name", ["chart.png", "chart.gpkg"])
+def test_an_out_without_a_draught_is_refused(tmp_path: Path, name: str) -> None:
+    result = _run("chart", str(ENC), "--out", str(tmp_path / name), "--quiet")
+    _one_error_line(result, "--out", "--draught")
+    assert result.exit_code == 2
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_out_under_a_file_is_refused(tmp_path: Path) -> None:
+    (tmp_path / "file").write_text("x")
+    result = _run("chart", str(ENC), "--draught", "5", "--out", str(tmp_path / "file" / "c.gpkg"))
+    _one_error_line(result, "c.gpkg", "which is a file")
+    assert result.exit_code == 2
+
+
+def test_the_chart_plot_outlines_the_coverage(tmp_path: Path) -> None:
+    from colregs9_cli.chart import load_chart
+    from colregs9_cli.report.chart_plot import draw_chart
+
+    chart = load_chart([ENC])
+    figure, ax = plt.subplots()
+    try:
+        draw_chart(ax, chart, 5.0, coverage=True)
+        (edge,) = [c for c in ax.collections if c.get_gid() == "coverage"]
+        assert edge.get_label().startswith("chart edge")
+        (path,) = edge.get_paths()
+        # the outline is the coverage's ring, the box of the cell's M_COVR
+        extents = path.get_extents()
+        np.testing.assert_allclose(
+            [extents.x0, extents.y0, extents.x1, extents.y1], chart.coverage.bounds
+        )
+        figure.clear()
+        ax = figure.add_subplot()
+        draw_chart(ax, chart, 5.0)  # the replay's figures keep their legend as it was
+        assert "coverage" not in {c.get_gid() for c in ax.collections}
+    finally:
+        plt.close(figure)

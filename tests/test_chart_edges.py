@@ -8,8 +8,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import shapely
 
-from colregs9_cli.chart import load_chart
+from colregs9_cli.chart import Chart, ChartLayer, load_chart
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.manoeuvrability import ManoeuvrabilityParams, Restriction, assess_manoeuvrability
 
@@ -48,8 +49,22 @@ def test_a_target_at_rest_10_m_inside_the_edge_is_unknown_not_restricted(chart) 
     north = _edge_north_m(chart) - 10.0
     result = assess_manoeuvrability(chart, north, 0.0, 0.0, 0.0, 50.0, 9.0, 5.0, PARAMS)
     assert len(result.restricted) == 360
+    # every ellipse crosses the water's boundary, which is the chart's edge: all were red
+    # when only the centres were checked against the coverage
+    assert result.restricted.all()
     assert not (result.restricted & result.covered).any()  # no red ellipse
     assert not result.covered.any()  # every ellipse reaches past the edge
+    assert result.restriction is Restriction.UNKNOWN
+
+
+def test_a_slow_target_along_the_edge_is_unknown_not_restricted(chart) -> None:
+    # 0.5 m/s heading east, 10 m inside the north edge: 341 of 360 ellipses cross the edge
+    # (all red before); the 19 that turn away from it far enough are wholly inside and blue.
+    north = _edge_north_m(chart) - 10.0
+    result = assess_manoeuvrability(chart, north, 0.0, 90.0, 0.5, 50.0, 9.0, 5.0, PARAMS)
+    assert result.restricted.sum() > 300
+    assert not (result.restricted & result.covered).any()
+    assert result.covered.any() and not result.restricted[result.covered].any()
     assert result.restriction is Restriction.UNKNOWN
 
 
@@ -69,3 +84,61 @@ def test_moving_towards_the_edge_only_the_far_ellipses_are_uncovered(chart) -> N
     assert not (result.restricted & result.covered).any()
     assert result.restriction is Restriction.UNKNOWN
     assert np.isfinite(result.north_m).all()
+
+
+def _deep_square() -> Chart:
+    """10 m everywhere in a 2 km square around the origin, in the frame (x east, y north)."""
+    square = shapely.box(-1000.0, -1000.0, 1000.0, 1000.0)
+    return Chart(
+        frame=FRAME,
+        depth_areas=np.array([square], dtype=object),
+        drval1_m=np.array([10.0]),
+        drval2_m=np.array([20.0]),
+        kinds=np.array([ChartLayer.DEPARE], dtype=object),
+        land=shapely.Polygon(),
+        hazards=shapely.Polygon(),
+        coverage=square,
+    )
+
+
+@pytest.mark.parametrize(
+    ("north_m", "expected"),
+    [(950.0, Restriction.UNKNOWN), (949.0, Restriction.NOT_RESTRICTED)],
+)
+def test_an_ellipse_touching_the_edge_from_inside_is_unknown(
+    north_m: float, expected: Restriction
+) -> None:
+    # At rest heading north, a = 50 m: from 950 m the ellipse's bow vertex lies on the north
+    # edge (1,000 m). It touches the chart's edge, so it is not wholly inside: unknown, not red.
+    result = assess_manoeuvrability(_deep_square(), north_m, 0.0, 0.0, 0.0, 50.0, 9.0, 5.0, PARAMS)
+    assert result.restriction is expected
+    assert not (result.restricted & result.covered).any()
+    assert result.covered.all() == (expected is Restriction.NOT_RESTRICTED)
+
+
+def _with_shoal(chart: Chart, shoal: shapely.Polygon) -> Chart:
+    return Chart(
+        frame=FRAME,
+        depth_areas=np.array([shapely.difference(chart.coverage, shoal), shoal], dtype=object),
+        drval1_m=np.array([10.0, 1.0]),
+        drval2_m=np.array([20.0, 2.0]),
+        kinds=np.array([ChartLayer.DEPARE, ChartLayer.DEPARE], dtype=object),
+        land=shapely.Polygon(),
+        hazards=shapely.Polygon(),
+        coverage=chart.coverage,
+    )
+
+
+def test_a_red_ellipse_inside_the_chart_still_decides_when_others_reach_past_the_edge() -> None:
+    # Heading north at 3 m/s from 800 m, her later ellipses reach past the north edge
+    # (1,000 m); a 1 m shoal 10 m east of her track, inside the chart, makes the first
+    # ellipses (half-width 13.5 m) red: the edge hides nothing that the chart does show.
+    deep = _deep_square()
+    clear = assess_manoeuvrability(deep, 800.0, 0.0, 0.0, 3.0, 50.0, 9.0, 5.0, PARAMS)
+    assert (~clear.covered).any() and not clear.restricted[clear.covered].any()
+    assert clear.restriction is Restriction.UNKNOWN
+    shoal = _with_shoal(deep, shapely.box(10.0, 780.0, 80.0, 830.0))
+    result = assess_manoeuvrability(shoal, 800.0, 0.0, 0.0, 3.0, 50.0, 9.0, 5.0, PARAMS)
+    assert (result.restricted & result.covered).any()
+    assert (~result.covered).any()
+    assert result.restriction is Restriction.RESTRICTED

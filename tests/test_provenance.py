@@ -13,6 +13,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from colregs9_cli.ais.load import load_ais
+from colregs9_cli.ais.sources import inspect_source, open_data
 from colregs9_cli.report.manifest import charts_manifest
 
 from fixture_files import DMA26, MARINECADASTRE, MODELLED_CHART, NMEA, SANDIEGO_ENC
@@ -84,6 +85,24 @@ def test_input_sha256_is_the_files_every_time(tmp_path: Path, kind: str) -> None
     for _ in range(REPEATS):
         (recorded,) = load_ais([path]).inputs
         assert recorded.sha256 == expected
+
+
+@pytest.mark.parametrize("compressed", [False, True])
+def test_the_hash_does_not_see_a_buffer_the_reader_refills(
+    tmp_path: Path, compressed: bool
+) -> None:
+    """A reader that scribbles over its buffer as soon as each read returns (as line readers
+    and the CSV chunker may) leaves the file's sha256 as it is."""
+    path = _big_plain_nmea(tmp_path)
+    if compressed:
+        path = _gzip(path, tmp_path)
+    expected = _sha256(path)
+    for _ in range(REPEATS):
+        buffer = bytearray(3 << 20)
+        with open_data(inspect_source(path)) as opened:
+            while opened.stream.readinto(buffer):  # type: ignore[attr-defined]
+                buffer[:] = bytes(len(buffer))
+            assert opened.finish() == expected
 
 
 def test_charts_are_recorded_with_every_file_and_its_hash() -> None:

@@ -19,7 +19,6 @@ import lzma
 import zipfile
 import zlib
 from collections.abc import Iterator
-from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -121,46 +120,33 @@ def _zip_member(path: Path) -> str:
 class _CountingReader(io.RawIOBase):
     """A raw binary reader that hashes and reports the bytes read through it.
 
-    The bytes of a read are copied and hashed on a thread of their own while the caller uses
-    them, so that hashing does not delay the CSV parse; the next read (or ``hexdigest``)
-    waits for it. The copy is what makes this safe: the caller owns the buffer again as soon
-    as the read returns and may refill it (hashing the caller's buffer itself gave a wrong,
-    run-dependent sha256 for plain files). A copy costs a memcpy, about 0.1 s per GB.
+    The bytes of a read are hashed before the read returns: the caller owns the buffer again
+    as soon as it does, and may refill or free it (hashing the caller's buffer on a worker
+    thread after the read returned gave a wrong, run-dependent sha256 for plain files).
+    Hashing here was also faster than hashing a copy on a thread of its own: on an 818 MB
+    DMA CSV (2 cores) 2.50-2.67 s against 2.64-2.72 s, and 0.3 s less CPU.
     """
 
     def __init__(self, raw: BinaryIO, hasher: hashlib._Hash | None, progress: ProgressSink) -> None:
         self._raw = raw
         self._hasher = hasher
         self._progress = progress
-        self._hashing: Future[None] | None = None
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="colregs9-sha256")
 
     def readable(self) -> bool:
         return True
 
     def readinto(self, buffer: memoryview | bytearray) -> int:  # type: ignore[override]
-        self._hashed()
         count = self._raw.readinto(buffer)  # type: ignore[attr-defined]
         if count:
             if self._hasher is not None:
-                self._hashing = self._pool.submit(self._hasher.update, bytes(buffer[:count]))
+                with memoryview(buffer) as view, view[:count] as data:
+                    self._hasher.update(data)
             self._progress.advance(count)
         return count or 0
-
-    def _hashed(self) -> None:
-        if self._hashing is not None:
-            self._hashing.result()
-            self._hashing = None
 
     def drain(self) -> None:
         while self.read(_CHUNK):
             pass
-        self._hashed()
-
-    def close(self) -> None:
-        self._hashed()
-        self._pool.shutdown()
-        super().close()
 
 
 class _Silent:

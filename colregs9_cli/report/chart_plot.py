@@ -78,8 +78,15 @@ def _patches(geometries: Iterable[Any]) -> tuple[list[PathPatch], list[int]]:
     return patches, kept
 
 
-def draw_chart(ax: Axes, chart: Chart, draught_m: float | None, ukc_m: float = 0.0) -> Any:
-    """Depth areas shaded by DRVAL1, land, and (with a draught) the navigable water outlined.
+def draw_chart(
+    ax: Axes,
+    chart: Chart,
+    draught_m: float | None,
+    ukc_m: float = 0.0,
+    coverage: bool = False,
+) -> Any:
+    """Depth areas shaded by DRVAL1, land, and (with a draught) the navigable water outlined;
+    with ``coverage``, the chart's edge (its coverage) dashed.
 
     Returns the depth-area collection (a ScalarMappable, for a colour bar).
     """
@@ -107,6 +114,19 @@ def draw_chart(ax: Axes, chart: Chart, draught_m: float | None, ukc_m: float = 0
         water.set_gid("navigable-water")
         water.set_label(f"navigable for draught {draught_m:g} m + UKC {ukc_m:g} m")
         ax.add_collection(water)
+    if coverage:
+        edge_patches, _ = _patches([chart.coverage])
+        edge = PatchCollection(
+            edge_patches,
+            facecolor="none",
+            edgecolor="0.15",
+            linestyle="--",
+            linewidth=1.0,
+            zorder=2,
+        )
+        edge.set_gid("coverage")
+        edge.set_label("chart edge (coverage): beyond it unknown")
+        ax.add_collection(edge)
     min_east, min_north, max_east, max_north = shapely.bounds(chart.coverage)
     ax.update_datalim([(min_east, min_north), (max_east, max_north)])
     ax.autoscale_view()
