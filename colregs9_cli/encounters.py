@@ -221,16 +221,19 @@ def find_encounters(
     tracks: Tracks,
     params: ReplayParams,
     own_mmsi: Iterable[int] | None = None,
+    counted_steps: tuple[int, int] | None = None,
+    require_own: bool = True,
 ) -> EncounterSearch:
     """All encounters in ``tracks``.
 
     With ``own_mmsi`` given, only those vessels take the own-ship seat (a pair of two of them
     is reported from both sides); otherwise every vessel does, so each pair appears twice.
-    An own MMSI with no samples is a ``NoDataError``.
+    An own MMSI with no samples is a ``NoDataError`` when ``require_own``.
+    ``candidate_pair_steps`` counts the steps in ``counted_steps`` (inclusive; default all).
     """
     samples = tracks.samples
     own = None if own_mmsi is None else frozenset(int(m) for m in own_mmsi)
-    if own is not None:
+    if own is not None and require_own:
         absent = sorted(own - set(samples["mmsi"].unique().tolist()))
         if absent:
             raise NoDataError(
@@ -264,7 +267,12 @@ def find_encounters(
             part = slice(lo, hi)
             i, j = candidate_pairs_nd(step[part], tuple(position[part].T), params.candidate_range_m)
             i, j = i + lo, j + lo
-            pair_steps += len(i)
+            if counted_steps is None:
+                pair_steps += len(i)
+            else:
+                pair_steps += int(
+                    ((step[i] >= counted_steps[0]) & (step[i] <= counted_steps[1])).sum()
+                )
             runs.append(_batch_runs(i, j, step, vessel, position, velocity, params))
     return EncounterSearch(
         encounters=_encounters(_join_runs(runs), vessel_ids, own, tracks),

@@ -32,7 +32,9 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import math
+import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -60,7 +62,7 @@ from .colregs import (
     colregs_params_from_table,
     evaluate_colregs,
 )
-from .encounters import Encounter, EncounterSearch, encounter_series, find_encounters, velocity_mps
+from .encounters import Encounter, encounter_series, velocity_mps
 from .errors import ChartError, NoDataError
 from .geo import LocalFrame, sail
 from .manoeuvrability import (
@@ -88,7 +90,17 @@ from .report.atomic import check_out_dir
 from .report.manifest import charts_manifest, inputs_manifest, jsonable, query_manifest, run_header
 from .report.replay_report import format_summary, write_replay_reports
 from .rule9 import Finding, PairVerdict, decide_pair, nav_status_finding
-from .tracks import Tracks, build_tracks
+from .slabs import (
+    Extent,
+    Segmentation,
+    SlabJob,
+    SlabResult,
+    run_slabs,
+    segment_slabs,
+    slab_of,
+    slabs_of_frame,
+)
+from .tracks import Tracks, TrackStats
 from .vessel_defaults import VesselDimensions, vessel_dimensions
 
 
@@ -128,35 +140,28 @@ def run_params(
     )
 
 
-def run_frame(
-    query: Query, positions: pd.DataFrame, chart: ChartSource | None = None
-) -> LocalFrame:
+def run_frame(query: Query, extent: Extent, chart: ChartSource | None = None) -> LocalFrame:
     """The query region's frame; without one, a frame centred on the charts (where the
-    manoeuvrability estimate is made), else on the data.
+    manoeuvrability estimate is made), else on the data (``slabs.Extent.frame``).
 
     The frame carries the chart, the manoeuvrability estimate and the figures; the geometry
-    between vessels never uses it (``encounters.py``). Centred on the data, its central
-    meridian is the circular mean of the longitudes, so that data across the antimeridian is
-    centred on it.
+    between vessels never uses it (``encounters.py``).
     """
     frame = query.frame()
     if frame is not None:
         return frame
     if chart is not None:
         return LocalFrame.centred_on(*chart.bounds_wgs84())
-    lon_rad = np.radians(positions["lon_deg"].to_numpy(dtype=float))
-    lon0 = float(np.degrees(np.arctan2(np.sin(lon_rad).mean(), np.cos(lon_rad).mean())))
-    lat = positions["lat_deg"]
-    return LocalFrame((float(lat.min()) + float(lat.max())) / 2.0, lon0)
+    return extent.frame()
 
 
-def _ledger_with_tracks(ledger: RejectsLedger, tracks: Tracks) -> RejectsLedger:
+def _ledger_with_tracks(ledger: RejectsLedger, stats: TrackStats) -> RejectsLedger:
     """The loader's ledger plus the reports that segmentation dropped."""
     result = copy.deepcopy(ledger)
-    dropped = tracks.stats.same_time_dropped + tracks.stats.speed_jump_dropped
+    dropped = stats.same_time_dropped + stats.speed_jump_dropped
     result.rows_used -= dropped
-    result.reject(RejectReason.DUPLICATE, tracks.stats.same_time_dropped)
-    result.reject(RejectReason.SPEED_JUMP, tracks.stats.speed_jump_dropped)
+    result.reject(RejectReason.DUPLICATE, stats.same_time_dropped)
+    result.reject(RejectReason.SPEED_JUMP, stats.speed_jump_dropped)
     return result
 
 
@@ -727,28 +732,16 @@ def _seat_outcome(
     )
 
 
-def _counts(tracks: Tracks, search: EncounterSearch) -> ReplayCounts:
-    pairs = {frozenset((e.own_mmsi, e.target_mmsi)) for e in search.encounters}
+def _counts(segmentation: Segmentation, results: Sequence[SlabResult]) -> ReplayCounts:
     return ReplayCounts(
-        vessels=len(tracks.vessels),
-        segments=tracks.stats.segments,
-        candidate_pair_steps=search.candidate_pair_steps,
-        candidate_pairs=len(pairs),
-        encounters=len(search.encounters),
-        triggered=len(search.triggered),
-        triggered_pairs=len(triggered_pairs(search)),
+        vessels=len(segmentation.vessels),
+        segments=segmentation.stats.segments,
+        candidate_pair_steps=sum(r.candidate_pair_steps for r in results),
+        candidate_pairs=len(frozenset().union(*(r.candidate_pairs for r in results))),
+        encounters=sum(r.encounters for r in results),
+        triggered=sum(r.triggered for r in results),
+        triggered_pairs=sum(len(r.pairs) for r in results),
     )
-
-
-def triggered_pairs(search: EncounterSearch) -> list[tuple[Encounter, tuple[int, ...]]]:
-    """Each triggered pair once, with the own-ship MMSIs of its reported seats, by start."""
-    seats: dict[tuple[int, int, int], list[Encounter]] = {}
-    for encounter in search.triggered:
-        a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
-        seats.setdefault((encounter.start_step, a, b), []).append(encounter)
-    return [
-        (found[0], tuple(sorted(e.own_mmsi for e in found))) for _, found in sorted(seats.items())
-    ]
 
 
 def _no_overlap(chart_paths: Sequence[Path], positions: pd.DataFrame) -> ChartError:
@@ -790,7 +783,7 @@ def build_manifest(
     chart_paths: Sequence[Path],
     frame: LocalFrame,
     params: ReplayRunParams,
-    tracks: Tracks,
+    track_stats: TrackStats,
     counts: ReplayCounts,
     pairs: tuple[PairOutcome, ...],
 ) -> dict[str, Any]:
@@ -805,7 +798,7 @@ def build_manifest(
         "chart_cells": [jsonable(cell) for cell in (chart.cells if chart is not None else ())],
         "ledger": ledger.to_dict(),
         "ledger_balanced": ledger.balanced,
-        "tracks": jsonable(tracks.stats),
+        "tracks": jsonable(track_stats),
         "counts": jsonable(counts),
         "verdicts": verdict_counts(pairs),
     }
@@ -838,8 +831,7 @@ def run_replay(
     if write:
         check_out_dir(target, overwrite)
     data = load_ais(ais_paths, query=query, fmt=fmt, quiet=quiet)
-    positions = data.positions
-    vessels_in_data = positions["mmsi"].nunique()
+    vessels_in_data = data.positions["mmsi"].nunique()
     if vessels_in_data < 2:
         raise NoDataError(
             f"{', '.join(str(p) for p in ais_paths)}: the AIS selected by query "
@@ -847,23 +839,27 @@ def run_replay(
             "Widen the query or give more AIS"
         )
     source = read_charts(chart_paths, accept_chart_gaps) if chart_paths else None
-    frame = run_frame(query, positions, source)
-    chart: Chart | None = None
-    if source is not None:
-        chart = load_run_chart(source, chart_paths, frame, positions)
-
-    tracks = build_tracks(positions, frame, params.replay, params.colregs.course_source)
-    ledger = _ledger_with_tracks(data.ledger, tracks)
-    search = find_encounters(tracks, params.replay, params.own_mmsi or None)
-    to_evaluate = triggered_pairs(search)
-    outcomes: list[PairOutcome] = []
-    with progress_bar("pairs", len(to_evaluate), progress_enabled(quiet)) as bar:
-        for encounter, seats in to_evaluate:
-            outcomes.append(evaluate_pair(tracks, encounter, seats, chart, params))
-            bar.advance()
-    counts = _counts(tracks, search)
+    slab_s = params.replay.slab_s
+    with tempfile.TemporaryDirectory(prefix="colregs9-slabs-") as scratch:
+        slabs = slabs_of_frame(data.positions, slab_s)
+        count = len(np.unique(slab_of(data.positions["timestamp"], slab_s)))
+        with progress_bar("tracks (slabs)", count, progress_enabled(quiet)) as bar:
+            segmentation = segment_slabs(slabs, Path(scratch), params.replay, bar)
+        data = dataclasses.replace(data, positions=data.positions.iloc[:0])
+        _check_own(params.own_mmsi, segmentation.vessels)
+        frame = run_frame(query, segmentation.extent, source)
+        chart: Chart | None = None
+        if source is not None:
+            chart = load_run_chart(source, chart_paths, frame, segmentation.points)
+        jobs = slab_jobs(segmentation, frame, params)
+        with progress_bar("pairs (slabs)", len(jobs), progress_enabled(quiet)) as bar:
+            results = run_slabs(jobs, functools.partial(_evaluate, params=params), chart, bar)
+    outcomes = [pair for result in results for pair in result.pairs]
+    ledger = _ledger_with_tracks(data.ledger, segmentation.stats)
+    track_stats = dataclasses.replace(segmentation.stats, samples=sum(r.samples for r in results))
+    counts = _counts(segmentation, results)
     manifest = build_manifest(
-        query, data, ledger, chart, chart_paths, frame, params, tracks, counts, tuple(outcomes)
+        query, data, ledger, chart, chart_paths, frame, params, track_stats, counts, tuple(outcomes)
     )
     result = ReplayResult(
         query_name=query.name,
@@ -880,6 +876,49 @@ def run_replay(
         with progress_bar("reports", len(result.encounters), progress_enabled(quiet)) as bar:
             files = write_replay_reports(result, chart, plots, bar)
     return dataclasses.replace(result, files=files, text=format_summary(result))
+
+
+def _evaluate(
+    tracks: Tracks,
+    encounter: Encounter,
+    seats: tuple[int, ...],
+    chart: Chart | None,
+    params: ReplayRunParams,
+) -> PairOutcome:
+    return evaluate_pair(tracks, encounter, seats, chart, params)
+
+
+def _check_own(own_mmsi: Sequence[int], vessels: np.ndarray) -> None:
+    absent = sorted(set(own_mmsi) - set(vessels.tolist()))
+    if absent:
+        raise NoDataError(
+            f"own MMSI {absent[0]} is not in the AIS data after cleaning; check --own-mmsi "
+            "against the vessels in the input and the query's region and time window"
+        )
+
+
+def slab_jobs(
+    segmentation: Segmentation, frame: LocalFrame, params: ReplayRunParams
+) -> list[SlabJob]:
+    """One job per slab from the first decided report to the last."""
+    if not segmentation.spill.files:
+        return []
+    slab_s = params.replay.slab_s
+    first = math.floor(segmentation.first_s / slab_s)
+    last = math.floor(segmentation.last_s / slab_s)
+    return [
+        SlabJob(
+            slab=index,
+            spill=segmentation.spill,
+            statics=segmentation.statics,
+            frame=frame,
+            params=params.replay,
+            course_source=params.colregs.course_source,
+            own_mmsi=params.own_mmsi,
+            data_end_s=segmentation.last_s,
+        )
+        for index in range(first, last + 1)
+    ]
 
 
 def verdict_counts(pairs: Sequence[PairOutcome]) -> dict[str, Any]:

@@ -50,6 +50,8 @@ class ReplayParams:
     - ``default_length_m``, ``default_breadth_m``, ``default_draught_m``: when given, used for
       every vessel that does not report the dimension; when not (the default), the value comes
       from the table of ``vessel_defaults.py`` by mobile type and ship type.
+    - ``slab_s``: the replay works through time in slabs of this length (``slabs.py``);
+      memory grows with it, the results do not depend on it.
     """
 
     step_s: float = 1.0
@@ -67,6 +69,7 @@ class ReplayParams:
     default_length_m: float | None = None
     default_breadth_m: float | None = None
     default_draught_m: float | None = None
+    slab_s: float = 1800.0
 
     @property
     def dimension_overrides(self) -> dict[str, float | None]:
@@ -86,6 +89,7 @@ class ReplayParams:
             "course_change_deg",
             "speed_change_frac",
             "reassess_every_s",
+            "slab_s",
         )
         for name in positive:
             value = getattr(self, name)

@@ -40,11 +40,12 @@ centred on all of Denmark, a CPA error of range·sin γ).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .geo import LocalFrame, ecef_m, true_bearing_deg
 from .replay_params import CourseSource, ReplayParams
@@ -91,7 +92,12 @@ SAMPLE_COLUMNS: tuple[str, ...] = ("mmsi", "segment_id", "step", "t_s", "timesta
 
 @dataclass(frozen=True)
 class TrackStats:
-    """What segmentation did, for the run manifest and the rejects ledger."""
+    """What segmentation did, for the run manifest and the rejects ledger.
+
+    ``samples`` counts the resampled samples at which a vessel is under way
+    (SOG ≥ ``min_sog_kn``): the samples the pair search works on. It does not depend on how
+    the run is cut into slabs.
+    """
 
     reports_in: int
     reports_used: int
@@ -102,6 +108,14 @@ class TrackStats:
     segments: int
     samples: int
 
+    def __add__(self, other: TrackStats) -> TrackStats:
+        return TrackStats(
+            *(getattr(self, f.name) + getattr(other, f.name) for f in dataclasses.fields(self))
+        )
+
+
+NO_TRACK_STATS = TrackStats(0, 0, 0, 0, 0, 0, 0, 0)
+
 
 @dataclass(frozen=True)
 class Tracks:
@@ -110,11 +124,11 @@ class Tracks:
     ``samples`` has one row per (``mmsi``, ``step``), sorted by ``mmsi`` then ``step``, with
     the columns ``SAMPLE_COLUMNS``: ``step`` is the integer k of the grid time
     ``t_s = k·step_s`` (seconds since the Unix epoch), ``timestamp`` the same instant in UTC,
-    ``segment_id`` numbers segments over the whole run, ``nav_status`` is nullable ``Int64``.
-    Angles are degrees in [0, 360) or NaN when unknown.
+    ``segment_id`` numbers the segments of these samples, ``nav_status`` is nullable
+    ``Int64``. Angles are degrees in [0, 360) or NaN when unknown.
 
-    ``vessels`` is indexed by ``mmsi`` (every vessel with samples) and holds the static
-    columns present in the input, each the vessel's last non-null value (NaN/None if none).
+    ``vessels`` is indexed by ``mmsi`` and holds the static columns present in the input,
+    each the vessel's last non-null value (NaN/None if none).
     """
 
     samples: pd.DataFrame
@@ -127,15 +141,31 @@ class Tracks:
         return pd.Timestamp(step * self.step_s, unit="s", tz="UTC")
 
 
-def build_tracks(
-    positions: pd.DataFrame,
-    frame: LocalFrame,
-    params: ReplayParams,
-    course_source: CourseSource = CourseSource.COG,
-) -> Tracks:
-    """Segment and resample ``positions`` (see the module docstring for the rules).
+# -- rules 1-3: segmentation, in one go or slab by slab --------------------------------------
+#
+# A report's fate depends on the vessel's last kept report (the anchor) and, when it jumps,
+# on the report after it. So segmentation can run through time slab by slab and decide every
+# report exactly as in one go: each slab carries, per vessel, its anchor and at most one
+# report still pending (the slab's last, a jump that the next report may confirm).
 
-    ``positions`` must be cleaned: canonical columns, non-null positions and timestamps.
+REPORT_COLUMNS: tuple[str, ...] = (
+    "mmsi",
+    "t_s",
+    "lat_deg",
+    "lon_deg",
+    "sog_kn",
+    "cog_deg",
+    "heading_deg",
+    "nav_status",
+)
+KEPT_COLUMNS: tuple[str, ...] = (*REPORT_COLUMNS, "segment_start")
+CARRY_COLUMNS: tuple[str, ...] = (*REPORT_COLUMNS, "pending")
+
+
+def report_table(positions: pd.DataFrame) -> pd.DataFrame:
+    """Cleaned canonical positions as the reports segmentation reads (``REPORT_COLUMNS``:
+    ``t_s`` seconds since the Unix epoch, numbers as float, NaN when unknown).
+
     A missing column or a null position is a programming error (``ValueError``).
     """
     missing = [c for c in REQUIRED_COLUMNS if c not in positions.columns]
@@ -144,81 +174,207 @@ def build_tracks(
     if positions[["timestamp", "mmsi", "lat_deg", "lon_deg"]].isna().any().any():
         raise ValueError("positions must be cleaned: null timestamp, MMSI or position found")
 
-    t_all = _epoch_seconds(positions["timestamp"])
-    mmsi_all = positions["mmsi"].to_numpy(dtype=np.int64)
+    def number(name: str) -> NDArray[np.float64]:
+        return pd.to_numeric(positions[name], errors="coerce").to_numpy(dtype=float)
+
+    return pd.DataFrame(
+        {
+            "mmsi": positions["mmsi"].to_numpy(dtype=np.int64),
+            "t_s": _epoch_seconds(positions["timestamp"]),
+            **{name: number(name) for name in REPORT_COLUMNS[2:]},
+        }
+    )
+
+
+def empty_carry() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "mmsi": np.zeros(0, dtype=np.int64),
+            **{name: np.zeros(0) for name in REPORT_COLUMNS[1:]},
+            "pending": np.zeros(0, dtype=bool),
+        }
+    )
+
+
+@dataclass(frozen=True)
+class Segmented:
+    """One slab's segmentation: its decided kept reports (``KEPT_COLUMNS``, sorted by MMSI
+    and time) with where segments start, the carry for the next slab, and the counts."""
+
+    kept: pd.DataFrame
+    carry: pd.DataFrame
+    stats: TrackStats
+
+
+def segment_reports(
+    reports: pd.DataFrame,
+    carry: pd.DataFrame,
+    params: ReplayParams,
+    until_s: float | None = None,
+) -> Segmented:
+    """Rules 1-3 on ``reports`` (``REPORT_COLUMNS``), all earlier than ``until_s`` and later
+    than every report of earlier slabs, continuing from ``carry``.
+
+    ``until_s`` is where the next slab starts; ``None`` means the data ends here, and every
+    pending report is decided (a jump nothing confirms is dropped).
+    """
+    rows = pd.concat([carry, reports.assign(pending=False)], ignore_index=True)
+    carried = np.r_[np.ones(len(carry), dtype=bool), np.zeros(len(reports), dtype=bool)]
+    mmsi_all = rows["mmsi"].to_numpy(dtype=np.int64)
+    t_all = rows["t_s"].to_numpy(dtype=float)
     order = np.lexsort((t_all, mmsi_all))
-    mmsi = mmsi_all[order]
-    t = t_all[order]
-    reports_in = len(t)
+    mmsi, t = mmsi_all[order], t_all[order]
 
     new_time = np.ones(len(t), dtype=bool)
     new_time[1:] = (mmsi[1:] != mmsi[:-1]) | (t[1:] != t[:-1])
     order, mmsi, t = order[new_time], mmsi[new_time], t[new_time]
-    same_time_dropped = reports_in - len(t)
+    same_time_dropped = int((~new_time).sum())
 
-    report_lat = positions["lat_deg"].to_numpy(dtype=float)[order]
-    report_lon = positions["lon_deg"].to_numpy(dtype=float)[order]
+    lat = rows["lat_deg"].to_numpy(dtype=float)[order]
+    lon = rows["lon_deg"].to_numpy(dtype=float)[order]
     # Distances between reports are measured on the Earth, not in the map frame, whose
     # scale grows away from its centre (a satellite feed's frame passes 2).
-    where = ecef_m(report_lat, report_lon)
-    keep, jump_split = _drop_jumps(mmsi, t, where, params)
-    speed_jump_dropped = int((~keep).sum())
-    order, mmsi, t, where = order[keep], mmsi[keep], t[keep], where[keep]
-    report_lat, report_lon = report_lat[keep], report_lon[keep]
-    jump_split = jump_split[keep]
-    north, east = frame.to_local(report_lat, report_lon)
+    keep, jump_split = _drop_jumps(mmsi, t, ecef_m(lat, lon), params)
+    last_of_vessel = np.r_[mmsi[1:] != mmsi[:-1], True]
+    # A jump at the end of the slab is decided by the next report, unless none can come in
+    # time to confirm it.
+    undecided = last_of_vessel & ~keep
+    if until_s is None:
+        undecided[:] = False
+    else:
+        undecided &= t >= until_s - params.max_gap_s
+    anchor = carried[order] & ~rows["pending"].to_numpy(dtype=bool)[order]
 
+    kept = keep.copy()
     first_of_vessel = np.ones(len(t), dtype=bool)
-    first_of_vessel[1:] = mmsi[1:] != mmsi[:-1]
-    gap = np.zeros(len(t), dtype=bool)
-    gap[1:] = (t[1:] - t[:-1]) > params.max_gap_s
-    gap &= ~first_of_vessel
-    segment_start = first_of_vessel | gap | jump_split
-    segment_of_report = np.cumsum(segment_start) - 1
+    kept_index = np.flatnonzero(kept)
+    kept_mmsi, kept_t = mmsi[kept_index], t[kept_index]
+    first = np.r_[True, kept_mmsi[1:] != kept_mmsi[:-1]]
+    gap = np.r_[False, (kept_t[1:] - kept_t[:-1]) > params.max_gap_s] & ~first
+    first_of_vessel[kept_index] = first
+    gap_at = np.zeros(len(t), dtype=bool)
+    gap_at[kept_index] = gap
+    segment_start = first_of_vessel | gap_at | jump_split
+    emitted = kept & ~anchor
 
-    def column(name: str) -> NDArray[np.float64]:
-        return pd.to_numeric(positions[name], errors="coerce").to_numpy(dtype=float)[order]
-
-    sog_kn, cog_deg = _fill_motion(
-        segment_of_report, t, report_lat, report_lon, column("sog_kn"), column("cog_deg")
+    last_kept = kept_index[np.r_[kept_mmsi[1:] != kept_mmsi[:-1], True]]
+    next_carry = np.zeros(len(t), dtype=bool)
+    next_carry[last_kept] = True
+    next_carry |= undecided
+    out = rows.iloc[order[emitted]][list(REPORT_COLUMNS)].reset_index(drop=True)
+    out["segment_start"] = segment_start[emitted]
+    carry_rows = rows.iloc[order[next_carry]][list(REPORT_COLUMNS)].reset_index(drop=True)
+    carry_rows["pending"] = undecided[next_carry]
+    stats = TrackStats(
+        reports_in=len(reports),
+        reports_used=int(emitted.sum()),
+        same_time_dropped=same_time_dropped,
+        speed_jump_dropped=int((~keep & ~undecided).sum()),
+        jump_splits=int((jump_split & emitted).sum()),
+        gap_splits=int((gap_at & emitted).sum()),
+        segments=int((segment_start & emitted).sum()),
+        samples=0,
     )
-    heading_deg = column("heading_deg")
+    return Segmented(kept=out, carry=carry_rows, stats=stats)
+
+
+# -- rules 4-5: motion and resampling of decided reports --------------------------------------
+
+
+def resample_reports(
+    kept: pd.DataFrame,
+    frame: LocalFrame,
+    params: ReplayParams,
+    course_source: CourseSource = CourseSource.COG,
+    steps: tuple[int, int] | None = None,
+    under_way_only: bool = False,
+) -> pd.DataFrame:
+    """Rules 4 and 5 on decided kept reports (``KEPT_COLUMNS``, sorted by MMSI and time):
+    the samples (``SAMPLE_COLUMNS``) at the grid steps ``steps`` (inclusive; default all).
+
+    A vessel's first report here starts a segment. Samples at steps whose neighbouring
+    reports (and theirs, for rule 4) are all present are exact; the caller gives enough
+    reports around ``steps`` (``context_s``). With ``under_way_only``, only vessels with a
+    report under way (SOG ≥ ``min_sog_kn``) within ``max_gap_s`` of ``steps`` are resampled:
+    the others cannot be in a pair there.
+    """
+    mmsi = kept["mmsi"].to_numpy(dtype=np.int64)
+    t = kept["t_s"].to_numpy(dtype=float)
+    segment_start = kept["segment_start"].to_numpy(dtype=bool) | np.r_[True, mmsi[1:] != mmsi[:-1]]
+    segment_of_report = np.cumsum(segment_start) - 1
+    lat = kept["lat_deg"].to_numpy(dtype=float)
+    lon = kept["lon_deg"].to_numpy(dtype=float)
+    sog_kn, cog_deg = _fill_motion(
+        segment_of_report,
+        t,
+        lat,
+        lon,
+        kept["sog_kn"].to_numpy(dtype=float),
+        kept["cog_deg"].to_numpy(dtype=float),
+    )
+    if under_way_only:
+        near = np.ones(len(t), dtype=bool)
+        if steps is not None:
+            near = (t >= steps[0] * params.step_s - params.max_gap_s) & (
+                t <= steps[1] * params.step_s + params.max_gap_s
+            )
+        moving = np.unique(mmsi[near & (sog_kn >= params.min_sog_kn)])
+        chosen = np.isin(mmsi, moving)
+        mmsi, t, lat, lon = mmsi[chosen], t[chosen], lat[chosen], lon[chosen]
+        sog_kn, cog_deg = sog_kn[chosen], cog_deg[chosen]
+        segment_start = segment_start[chosen] | np.r_[True, mmsi[1:] != mmsi[:-1]]
+        kept = kept[chosen]
+    heading_deg = kept["heading_deg"].to_numpy(dtype=float)
     heading_deg = np.where(np.isnan(heading_deg), cog_deg, heading_deg)
     course_deg = heading_deg if course_source is CourseSource.HEADING else cog_deg
-
+    north, east = frame.to_local(lat, lon)
     samples = _resample(
         segment_start,
         mmsi,
         t,
         {"north_m": north, "east_m": east, "sog_kn": sog_kn},
         {"cog_deg": cog_deg, "heading_deg": heading_deg, "course_deg": course_deg},
-        column("nav_status"),
+        kept["nav_status"].to_numpy(dtype=float),
         params.step_s,
     )
-    lat, lon = frame.to_geodetic(samples["north_m"], samples["east_m"])
-    samples["lat_deg"] = lat
-    samples["lon_deg"] = lon
-    convergence_deg = frame.grid_convergence_deg(lat, lon)
+    if steps is not None:
+        samples = samples[samples["step"].between(*steps)].reset_index(drop=True)
+    sample_lat, sample_lon = frame.to_geodetic(samples["north_m"], samples["east_m"])
+    samples["lat_deg"] = sample_lat
+    samples["lon_deg"] = sample_lon
+    convergence_deg = frame.grid_convergence_deg(sample_lat, sample_lon)
     for name in ("cog", "heading", "course"):
         samples[f"{name}_grid_deg"] = wrap_deg(samples[f"{name}_deg"] - convergence_deg)
     samples["speed_mps"] = samples["sog_kn"] * MPS_PER_KNOT
     samples["timestamp"] = pd.to_datetime(samples["t_s"], unit="s", utc=True)
-    samples = samples[list(SAMPLE_COLUMNS)]
+    return samples[list(SAMPLE_COLUMNS)]
 
-    stats = TrackStats(
-        reports_in=reports_in,
-        reports_used=len(t),
-        same_time_dropped=same_time_dropped,
-        speed_jump_dropped=speed_jump_dropped,
-        jump_splits=int(jump_split.sum()),
-        gap_splits=int(gap.sum()),
-        segments=int(segment_start.sum()),
-        samples=len(samples),
-    )
+
+def context_s(params: ReplayParams) -> float:
+    """How far around a window of steps the reports must reach for its samples to be exact:
+    the reports bracketing a sample are within ``max_gap_s`` of it, and rule 4 looks at
+    their neighbours, within ``max_gap_s`` again."""
+    return 2.0 * params.max_gap_s + 2.0 * params.step_s
+
+
+def build_tracks(
+    positions: pd.DataFrame,
+    frame: LocalFrame,
+    params: ReplayParams,
+    course_source: CourseSource = CourseSource.COG,
+) -> Tracks:
+    """Segment and resample ``positions`` in one go (see the module docstring for the rules).
+
+    ``positions`` must be cleaned: canonical columns, non-null positions and timestamps.
+    A missing column or a null position is a programming error (``ValueError``).
+    """
+    segmented = segment_reports(report_table(positions), empty_carry(), params)
+    samples = resample_reports(segmented.kept, frame, params, course_source)
+    under_way = int((samples["sog_kn"].to_numpy() >= params.min_sog_kn).sum())
     return Tracks(
         samples=samples,
-        vessels=_vessels(positions, samples["mmsi"].unique()),
-        stats=stats,
+        vessels=vessel_statics(positions, samples["mmsi"].unique()),
+        stats=dataclasses.replace(segmented.stats, samples=under_way),
         step_s=params.step_s,
         frame=frame,
     )
@@ -339,7 +495,7 @@ def _resample(
 ) -> pd.DataFrame:
     """Rule 5, vectorised over all segments at once."""
     first = np.flatnonzero(segment_start)
-    last = np.r_[first[1:], len(t)] - 1
+    last = np.append(first[1:], len(t))[: len(first)] - 1
     # A tolerance keeps report times that are grid times (up to rounding) on the grid.
     k_first = np.ceil(t[first] / step_s - 1e-9).astype(np.int64)
     k_last = np.floor(t[last] / step_s + 1e-9).astype(np.int64)
@@ -349,13 +505,16 @@ def _resample(
     step = k_first[sample_segment] + (np.arange(counts.sum()) - offsets[sample_segment])
     grid_t = step * step_s
 
-    # Interval search on a key that is increasing over (segment, time).
+    # Interval search on an integer key, increasing over (segment, time) in milliseconds:
+    # exact, so that a sample finds the same reports whatever else is resampled with it.
     segment_of_report = np.cumsum(segment_start) - 1
-    relative_t = t - t[first][segment_of_report]
-    span = float(relative_t.max(initial=0.0)) + 2.0 * step_s + 1.0
-    report_key = segment_of_report * span + relative_t
-    sample_relative = grid_t - t[first][sample_segment]
-    sample_key = sample_segment * span + sample_relative
+    report_ms = np.rint(t * 1000.0).astype(np.int64)
+    relative_ms = report_ms - report_ms[first][segment_of_report]
+    span_ms = int(relative_ms.max(initial=0)) + 1
+    report_key = segment_of_report * span_ms + relative_ms
+    grid_ms = np.rint(grid_t * 1000.0).astype(np.int64)
+    sample_relative_ms = grid_ms - report_ms[first][sample_segment]
+    sample_key = sample_segment * span_ms + np.clip(sample_relative_ms, 0, span_ms - 1)
     left = np.searchsorted(report_key, sample_key, side="right") - 1
     left = np.clip(left, first[sample_segment], last[sample_segment])
     right = np.minimum(left + 1, last[sample_segment])
@@ -382,11 +541,25 @@ def _resample(
     return pd.DataFrame(data)
 
 
-def _vessels(positions: pd.DataFrame, mmsis: NDArray[np.int64]) -> pd.DataFrame:
+def latest_statics(positions: pd.DataFrame, earlier: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Each vessel's last non-null value of each static column in ``positions``, else its
+    value in ``earlier`` (the same from earlier positions), indexed by MMSI."""
     present = [c for c in STATIC_COLUMNS if c in positions.columns]
     ordered = positions.sort_values("timestamp", kind="stable")
-    statics = ordered.groupby("mmsi")[present].last() if present else None
-    index = pd.Index(np.sort(mmsis), name="mmsi")
+    latest = ordered.groupby("mmsi")[present].last()
+    if earlier is None or earlier.empty:
+        return latest
+    if latest.empty:
+        return earlier
+    return latest.combine_first(earlier)[present]
+
+
+def vessel_statics(
+    positions: pd.DataFrame | None, mmsis: ArrayLike, statics: pd.DataFrame | None = None
+) -> pd.DataFrame:
+    """The static table of ``Tracks.vessels`` for ``mmsis``: from ``statics``
+    (``latest_statics``) when given, else from ``positions``."""
     if statics is None:
-        return pd.DataFrame(index=index)
+        statics = latest_statics(positions) if positions is not None else pd.DataFrame()
+    index = pd.Index(np.sort(np.asarray(mmsis, dtype=np.int64)), name="mmsi")
     return statics.reindex(index)

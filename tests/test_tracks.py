@@ -304,7 +304,11 @@ def test_real_nmea_sample(fixtures_dir: Path) -> None:
     # 18, 17 of them 1 s timestamp jitter of the ≈34 kn craft 219017081. 219601000 (≈36 kn)
     # still repeats a stale position three times, then jumps, confirmed by the next report:
     # split. Resampling never extrapolates, so a vessel whose reports all fall inside one
-    # grid second has no sample: 1,112 of the 1,438 vessels have samples.
+    # grid second has no sample: 1,112 of the 1,438 vessels have samples. Of their 282,777
+    # samples, 117,411 are under way (SOG >= 0.5 kn), the ones the pair search uses.
+    assert len(tracks.samples) == 282777
+    under_way = tracks.samples["sog_kn"] >= ReplayParams().min_sog_kn
+    assert tracks.stats.samples == int(under_way.sum())
     assert tracks.stats == TrackStats(
         reports_in=24688,
         reports_used=24688 - 4,
@@ -313,7 +317,7 @@ def test_real_nmea_sample(fixtures_dir: Path) -> None:
         jump_splits=3,
         gap_splits=0,
         segments=1438 + 3,
-        samples=282777,
+        samples=117411,
     )
     assert len(tracks.vessels) == 1112
     assert tracks.samples["mmsi"].nunique() == 1112

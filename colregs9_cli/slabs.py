@@ -1,0 +1,406 @@
+"""Replay through time in slabs, in bounded memory, with the results of one go (DESIGN §6).
+
+**Stage 1, segmentation** (``segment_slabs``, one pass in time order): the positions of each
+slab are segmented (``tracks.segment_reports``, which carries each vessel's last kept report
+from slab to slab, so every report is decided as in one go) and the decided reports are
+spilled to one Parquet file per slab in a scratch directory. On the way it gathers the
+vessels' static data, the extent of the data (for the run's frame), a few positions per
+0.01° cell (to check that a chart covers the AIS) and the counts.
+
+**Stage 2, the slabs** (``replay_slab``, a pure function of its ``SlabJob``: slabs run in any
+order and in any process): a slab owns the encounters that start in its core, ``[k·slab_s,
+(k+1)·slab_s)``. It reads the decided reports of a window around the core from the spill
+(``Spill.read``, with ``pyarrow.dataset``'s filters), resamples only the vessels under way
+there (``tracks.resample_reports``), searches the pairs, and evaluates its triggered pairs
+(``replay.evaluate_pair`` is handed in by the caller). The window reaches before the core by
+one step plus the context the resampling needs, so an encounter that started earlier is seen
+to have started earlier; and after it by a tail that holds most encounters whole. An
+encounter still going on at the window's end (two vessels sailing together for hours) is
+followed for its two vessels alone, in windows that double, until it ends or the data does.
+
+What is exact: every sample a slab uses is the sample one go would make (same reports, same
+neighbours), so the encounters, verdicts and counts do not depend on the slab length or on
+the number of workers. Memory is set by the slab length and the traffic, not by the run's
+duration.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.dataset as ds
+import pyarrow.parquet as pq
+from numpy.typing import NDArray
+
+from .chart import Chart
+from .encounters import Encounter, find_encounters
+from .geo import LocalFrame
+from .progress import ProgressSink
+from .replay_params import CourseSource, ReplayParams
+from .replay_results import PairOutcome
+from .tracks import (
+    KEPT_COLUMNS,
+    NO_TRACK_STATS,
+    Tracks,
+    TrackStats,
+    context_s,
+    empty_carry,
+    latest_statics,
+    report_table,
+    resample_reports,
+    segment_reports,
+    vessel_statics,
+)
+
+# Sums of sines and cosines of longitudes in fixed point, so that the frame's centre does
+# not depend on the order in which slabs add them up.
+_FIXED_POINT = float(2**30)
+# One position per cell of this size (degrees) is kept for the chart-overlap check.
+_POINT_CELL_DEG = 0.01
+
+
+@dataclass(frozen=True)
+class SpillFile:
+    path: Path
+    t_min_s: float
+    t_max_s: float
+
+
+@dataclass(frozen=True)
+class Spill:
+    """The decided reports of stage 1, one Parquet file per slab (``KEPT_COLUMNS``)."""
+
+    files: tuple[SpillFile, ...]
+
+    def read(
+        self, t_from_s: float, t_to_s: float, mmsis: Sequence[int] | None = None
+    ) -> pd.DataFrame:
+        """The decided reports with ``t_from_s <= t_s <= t_to_s`` (of ``mmsis``), sorted by
+        MMSI and time."""
+        paths = [str(f.path) for f in self.files if f.t_max_s >= t_from_s and f.t_min_s <= t_to_s]
+        if not paths:
+            return _empty_kept()
+        wanted = (ds.field("t_s") >= t_from_s) & (ds.field("t_s") <= t_to_s)
+        if mmsis is not None:
+            wanted &= ds.field("mmsi").isin(pa.array(list(mmsis), type=pa.int64()))
+        frame = ds.dataset(paths, format="parquet").to_table(filter=wanted).to_pandas()
+        order = np.lexsort((frame["t_s"].to_numpy(), frame["mmsi"].to_numpy()))
+        return frame.iloc[order].reset_index(drop=True)
+
+
+def _empty_kept() -> pd.DataFrame:
+    return pd.DataFrame(
+        {
+            "mmsi": np.zeros(0, dtype=np.int64),
+            **{name: np.zeros(0) for name in KEPT_COLUMNS[1:-1]},
+            "segment_start": np.zeros(0, dtype=bool),
+        }
+    )
+
+
+@dataclass
+class Extent:
+    """Where the data lies: its latitude range and the fixed-point sums of the sines and
+    cosines of its longitudes (their circular mean centres the frame)."""
+
+    lat_min_deg: float = math.inf
+    lat_max_deg: float = -math.inf
+    lon_sin_sum: int = 0
+    lon_cos_sum: int = 0
+
+    def add(self, lat_deg: NDArray[np.float64], lon_deg: NDArray[np.float64]) -> None:
+        if len(lat_deg) == 0:
+            return
+        self.lat_min_deg = min(self.lat_min_deg, float(lat_deg.min()))
+        self.lat_max_deg = max(self.lat_max_deg, float(lat_deg.max()))
+        lon_rad = np.radians(lon_deg)
+        self.lon_sin_sum += int(np.rint(np.sin(lon_rad) * _FIXED_POINT).astype(np.int64).sum())
+        self.lon_cos_sum += int(np.rint(np.cos(lon_rad) * _FIXED_POINT).astype(np.int64).sum())
+
+    def frame(self) -> LocalFrame:
+        """A frame centred on the data: the middle of its latitudes, and the circular mean
+        of its longitudes (so that data across the antimeridian is centred on it)."""
+        lon0 = math.degrees(math.atan2(self.lon_sin_sum, self.lon_cos_sum))
+        return LocalFrame((self.lat_min_deg + self.lat_max_deg) / 2.0, lon0)
+
+
+@dataclass
+class _Points:
+    """At most one position per ``_POINT_CELL_DEG`` cell: the first one seen."""
+
+    cells: dict[tuple[int, int], tuple[float, float]] = field(default_factory=dict)
+
+    def add(self, lat_deg: NDArray[np.float64], lon_deg: NDArray[np.float64]) -> None:
+        row = np.floor(lat_deg / _POINT_CELL_DEG).astype(np.int64)
+        column = np.floor(lon_deg / _POINT_CELL_DEG).astype(np.int64)
+        _, first = np.unique(row * 100_000 + column, return_index=True)
+        for i in first:
+            self.cells.setdefault((int(row[i]), int(column[i])), (lat_deg[i], lon_deg[i]))
+
+    def frame(self) -> pd.DataFrame:
+        values = np.asarray(list(self.cells.values()), dtype=float).reshape(-1, 2)
+        return pd.DataFrame({"lat_deg": values[:, 0], "lon_deg": values[:, 1]})
+
+
+@dataclass(frozen=True)
+class Segmentation:
+    """Stage 1's result: the spill, the static table, the vessels with decided reports, the
+    extent, sample positions, the time span of the decided reports, and the counts."""
+
+    spill: Spill
+    statics: pd.DataFrame
+    vessels: NDArray[np.int64]
+    extent: Extent
+    points: pd.DataFrame
+    first_s: float
+    last_s: float
+    stats: TrackStats
+
+
+def slab_of(timestamps: pd.Series, slab_s: float) -> NDArray[np.int64]:
+    """The slab index ``floor(t / slab_s)`` of each timestamp (seconds since the epoch)."""
+    milliseconds = pd.to_datetime(timestamps, utc=True).dt.as_unit("ms").astype("int64")
+    return np.floor(milliseconds.to_numpy() / (slab_s * 1000.0)).astype(np.int64)
+
+
+def slabs_of_frame(positions: pd.DataFrame, slab_s: float) -> Iterator[tuple[int, pd.DataFrame]]:
+    """The positions of each slab in turn, from a frame of positions held in memory."""
+    slab = slab_of(positions["timestamp"], slab_s)
+    for index, part in positions.groupby(slab, sort=True):
+        yield int(index), part  # type: ignore[call-overload]
+
+
+def segment_slabs(
+    slabs: Iterable[tuple[int, pd.DataFrame]],
+    spill_dir: Path,
+    params: ReplayParams,
+    bar: ProgressSink,
+) -> Segmentation:
+    """Stage 1 over the slabs' positions, given in increasing slab order (canonical
+    columns, cleaned; see ``tracks.report_table``)."""
+    carry = empty_carry()
+    stats = NO_TRACK_STATS
+    statics: pd.DataFrame | None = None
+    extent = Extent()
+    points = _Points()
+    files: list[SpillFile] = []
+    vessels: set[int] = set()
+    first_s, last_s = math.inf, -math.inf
+    upcoming = iter(slabs)
+    current = next(upcoming, None)
+    while current is not None:
+        following = next(upcoming, None)
+        index, positions = current
+        reports = report_table(positions)
+        lat = reports["lat_deg"].to_numpy()
+        lon = reports["lon_deg"].to_numpy()
+        extent.add(lat, lon)
+        points.add(lat, lon)
+        statics = latest_statics(positions, statics)
+        until_s = None if following is None else (index + 1) * params.slab_s
+        segmented = segment_reports(reports, carry, params, until_s)
+        carry = segmented.carry
+        stats = stats + segmented.stats
+        kept = segmented.kept
+        if len(kept):
+            path = spill_dir / f"slab-{index:012d}.parquet"
+            pq.write_table(pa.Table.from_pandas(kept, preserve_index=False), path)
+            t = kept["t_s"].to_numpy()
+            files.append(SpillFile(path, float(t.min()), float(t.max())))
+            first_s, last_s = min(first_s, float(t.min())), max(last_s, float(t.max()))
+            vessels.update(np.unique(kept["mmsi"].to_numpy()).tolist())
+        bar.advance()
+        current = following
+    return Segmentation(
+        spill=Spill(tuple(files)),
+        statics=statics if statics is not None else pd.DataFrame(),
+        vessels=np.asarray(sorted(vessels), dtype=np.int64),
+        extent=extent,
+        points=points.frame(),
+        first_s=first_s,
+        last_s=last_s,
+        stats=stats,
+    )
+
+
+# -- stage 2 --------------------------------------------------------------------------------
+
+PairEvaluator = Callable[[Tracks, Encounter, tuple[int, ...], "Chart | None"], PairOutcome]
+
+
+@dataclass(frozen=True)
+class SlabJob:
+    """Everything one slab needs; no state is shared between slabs."""
+
+    slab: int
+    spill: Spill
+    statics: pd.DataFrame
+    frame: LocalFrame
+    params: ReplayParams
+    course_source: CourseSource
+    own_mmsi: tuple[int, ...]
+    data_end_s: float
+
+    @property
+    def core_steps(self) -> tuple[int, int]:
+        """The grid steps the slab owns (inclusive): those with a time in its core."""
+        step_s, slab_s = self.params.step_s, self.params.slab_s
+        first = math.ceil(self.slab * slab_s / step_s - 1e-9)
+        last = math.ceil((self.slab + 1) * slab_s / step_s - 1e-9) - 1
+        return first, last
+
+
+@dataclass(frozen=True)
+class SlabResult:
+    """A slab's pairs (in the order of ``triggered_pairs``) and its share of the counts."""
+
+    slab: int
+    pairs: tuple[PairOutcome, ...]
+    candidate_pair_steps: int
+    candidate_pairs: frozenset[tuple[int, int]]
+    encounters: int
+    triggered: int
+    samples: int
+    followed: int  # encounters followed past the slab's window
+
+
+def tail_steps(params: ReplayParams) -> int:
+    """How far past its core a slab's window reaches: two TCPA_act (a trigger at the end of
+    the core, its TCPA and the pass after it) and a minute."""
+    return math.ceil((2.0 * params.tcpa_act_s + 60.0) / params.step_s)
+
+
+def _tracks(job: SlabJob, steps: tuple[int, int], mmsis: Sequence[int] | None) -> Tracks:
+    """Exact samples at ``steps``: of the vessels under way, or of ``mmsis`` whatever
+    their speed."""
+    params = job.params
+    margin_s = context_s(params)
+    reports = job.spill.read(
+        steps[0] * params.step_s - margin_s, steps[1] * params.step_s + margin_s, mmsis
+    )
+    samples = resample_reports(
+        reports, job.frame, params, job.course_source, steps, under_way_only=mmsis is None
+    )
+    return Tracks(
+        samples=samples,
+        vessels=vessel_statics(None, samples["mmsi"].unique(), job.statics),
+        stats=NO_TRACK_STATS,
+        step_s=params.step_s,
+        frame=job.frame,
+    )
+
+
+def _last_needed_step(encounter: Encounter, params: ReplayParams) -> int:
+    """The last step the encounter's evaluation reads (``replay.evaluate_pair``)."""
+    if encounter.trigger_step is None or encounter.tcpa_s_at_trigger is None:
+        return encounter.end_step
+    horizon = math.ceil((encounter.tcpa_s_at_trigger + params.tcpa_act_s) / params.step_s)
+    return max(encounter.end_step, encounter.trigger_step + horizon)
+
+
+def _whole(encounter: Encounter, last_step: int, params: ReplayParams) -> bool:
+    """True when the window up to ``last_step`` holds all the encounter's evaluation reads
+    and shows where its run ends."""
+    return encounter.end_step < last_step and _last_needed_step(encounter, params) <= last_step
+
+
+def replay_slab(job: SlabJob, evaluate: PairEvaluator, chart: Chart | None) -> SlabResult:
+    """Stage 2 for one slab (see the module docstring)."""
+    params = job.params
+    core = job.core_steps
+    last_data_step = math.floor(job.data_end_s / params.step_s)
+    window = (core[0] - 1, core[1] + tail_steps(params))
+    tracks = _tracks(job, window, None)
+    own = job.own_mmsi or None
+    search = find_encounters(tracks, params, own, counted_steps=core, require_own=False)
+    owned: list[tuple[Encounter, Tracks]] = []
+    followed = 0
+    for encounter in search.encounters:
+        if not core[0] <= encounter.start_step <= core[1]:
+            continue
+        if _whole(encounter, window[1], params) or window[1] > last_data_step:
+            owned.append((encounter, tracks))
+            continue
+        followed += 1
+        owned.append(_follow(job, encounter, window))
+    encounters = tuple(e for e, _ in owned)
+    by_id = {e.encounter_id: t for e, t in owned}
+    pairs = []
+    for encounter, seats in triggered_pairs(encounters):
+        pairs.append(evaluate(by_id[encounter.encounter_id], encounter, seats, chart))
+    return SlabResult(
+        slab=job.slab,
+        pairs=tuple(pairs),
+        candidate_pair_steps=search.candidate_pair_steps,
+        candidate_pairs=frozenset(
+            (min(e.own_mmsi, e.target_mmsi), max(e.own_mmsi, e.target_mmsi)) for e in encounters
+        ),
+        encounters=len(encounters),
+        triggered=sum(e.triggered for e in encounters),
+        samples=int(
+            (
+                tracks.samples["step"].between(*core)
+                & (tracks.samples["sog_kn"] >= params.min_sog_kn)
+            ).sum()
+        ),
+        followed=followed,
+    )
+
+
+def _follow(
+    job: SlabJob, encounter: Encounter, window: tuple[int, int]
+) -> tuple[Encounter, Tracks]:
+    """The encounter as far as it goes: its two vessels alone, in windows that double."""
+    params = job.params
+    pair = (encounter.own_mmsi, encounter.target_mmsi)
+    own = [m for m in job.own_mmsi if m in pair] if job.own_mmsi else None
+    last_data_step = math.floor(job.data_end_s / params.step_s)
+    reach = window[1] - window[0]
+    while True:
+        reach *= 2
+        steps = (window[0], window[0] + reach)
+        tracks = _tracks(job, steps, pair)
+        search = find_encounters(tracks, params, own, require_own=False)
+        (longer,) = (
+            e
+            for e in search.encounters
+            if e.start_step == encounter.start_step
+            and (e.own_mmsi, e.target_mmsi) == (encounter.own_mmsi, encounter.target_mmsi)
+        )
+        if _whole(longer, steps[1], params) or steps[1] > last_data_step:
+            return longer, tracks
+
+
+def triggered_pairs(
+    encounters: Iterable[Encounter],
+) -> list[tuple[Encounter, tuple[int, ...]]]:
+    """Each triggered pair once, with the own-ship MMSIs of its reported seats, by start."""
+    seats: dict[tuple[int, int, int], list[Encounter]] = {}
+    for encounter in encounters:
+        if not encounter.triggered:
+            continue
+        a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
+        seats.setdefault((encounter.start_step, a, b), []).append(encounter)
+    return [
+        (found[0], tuple(sorted(e.own_mmsi for e in found))) for _, found in sorted(seats.items())
+    ]
+
+
+def run_slabs(
+    jobs: Sequence[SlabJob],
+    evaluate: PairEvaluator,
+    chart: Chart | None,
+    bar: ProgressSink,
+) -> list[SlabResult]:
+    """Stage 2 over ``jobs`` in this process, in order."""
+    results = []
+    for job in jobs:
+        results.append(replay_slab(job, evaluate, chart))
+        bar.advance()
+    return results
