@@ -861,6 +861,11 @@ def run_replay(
     manifest = build_manifest(
         query, data, ledger, chart, chart_paths, frame, params, track_stats, counts, tuple(outcomes)
     )
+    manifest["slabs"] = {
+        "slab_s": slab_s,
+        "slabs": len(jobs),
+        "pairs_followed_past_their_slab": sum(r.followed for r in results),
+    }
     result = ReplayResult(
         query_name=query.name,
         out_dir=target,

@@ -267,7 +267,7 @@ class SlabResult:
     encounters: int
     triggered: int
     samples: int
-    followed: int  # encounters followed past the slab's window
+    followed: int  # pairs followed past the slab's window
 
 
 def tail_steps(params: ReplayParams) -> int:
@@ -320,15 +320,19 @@ def replay_slab(job: SlabJob, evaluate: PairEvaluator, chart: Chart | None) -> S
     own = job.own_mmsi or None
     search = find_encounters(tracks, params, own, counted_steps=core, require_own=False)
     owned: list[tuple[Encounter, Tracks]] = []
-    followed = 0
+    followed: dict[tuple[int, ...], tuple[Encounter, Tracks]] = {}
     for encounter in search.encounters:
         if not core[0] <= encounter.start_step <= core[1]:
             continue
         if _whole(encounter, window[1], params) or window[1] > last_data_step:
             owned.append((encounter, tracks))
             continue
-        followed += 1
-        owned.append(_follow(job, encounter, window))
+        pair = (encounter.start_step, *sorted((encounter.own_mmsi, encounter.target_mmsi)))
+        if pair not in followed:
+            for longer in _follow(job, encounter, window):
+                key = (longer[0].own_mmsi, longer[0].target_mmsi)
+                followed[(*pair, *key)] = longer
+        owned.append(followed[(*pair, encounter.own_mmsi, encounter.target_mmsi)])
     encounters = tuple(e for e, _ in owned)
     by_id = {e.encounter_id: t for e, t in owned}
     pairs = []
@@ -349,14 +353,15 @@ def replay_slab(job: SlabJob, evaluate: PairEvaluator, chart: Chart | None) -> S
                 & (tracks.samples["sog_kn"] >= params.min_sog_kn)
             ).sum()
         ),
-        followed=followed,
+        followed=len({key[:3] for key in followed}),
     )
 
 
 def _follow(
     job: SlabJob, encounter: Encounter, window: tuple[int, int]
-) -> tuple[Encounter, Tracks]:
-    """The encounter as far as it goes: its two vessels alone, in windows that double."""
+) -> list[tuple[Encounter, Tracks]]:
+    """The encounter as far as it goes, in each of its seats: its two vessels alone, in
+    windows that double."""
     params = job.params
     pair = (encounter.own_mmsi, encounter.target_mmsi)
     own = [m for m in job.own_mmsi if m in pair] if job.own_mmsi else None
@@ -367,14 +372,9 @@ def _follow(
         steps = (window[0], window[0] + reach)
         tracks = _tracks(job, steps, pair)
         search = find_encounters(tracks, params, own, require_own=False)
-        (longer,) = (
-            e
-            for e in search.encounters
-            if e.start_step == encounter.start_step
-            and (e.own_mmsi, e.target_mmsi) == (encounter.own_mmsi, encounter.target_mmsi)
-        )
-        if _whole(longer, steps[1], params) or steps[1] > last_data_step:
-            return longer, tracks
+        seats = [e for e in search.encounters if e.start_step == encounter.start_step]
+        if all(_whole(e, steps[1], params) for e in seats) or steps[1] > last_data_step:
+            return [(e, tracks) for e in seats]
 
 
 def triggered_pairs(
