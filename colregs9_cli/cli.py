@@ -146,6 +146,41 @@ def replay_command(
             help="Replace an --out directory that holds something other than a colregs9 report.",
         ),
     ] = False,
+    slab_minutes: Annotated[
+        float | None,
+        typer.Option(
+            "--slab-minutes",
+            metavar="MIN",
+            help="Work through time in slabs this long: memory grows with it, results do not "
+            "change; 30.",
+        ),
+    ] = None,
+    workers: Annotated[
+        int,
+        typer.Option(
+            "--workers",
+            metavar="N",
+            help="Run the slabs on a local Dask cluster of N worker processes; 1 runs them here.",
+        ),
+    ] = 1,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(
+            "--scheduler",
+            metavar="ADDRESS",
+            help="Run the slabs on the Dask cluster whose scheduler is at ADDRESS "
+            "(tcp://host:8786) instead.",
+        ),
+    ] = None,
+    scratch: Annotated[
+        Path | None,
+        typer.Option(
+            "--scratch",
+            metavar="DIR",
+            help="Where to spill the decided reports (default: the system's temporary "
+            "directory); on a multi-machine cluster, a directory every worker mounts.",
+        ),
+    ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
 ) -> None:
     """Replay AIS pair by pair through COLREGs rules 13–15 and the rule 9 automaton.
@@ -173,6 +208,7 @@ def replay_command(
                     "cpa_req_m": cpa_req_m,
                     "candidate_range_m": candidate_range_m,
                     "min_sog_kn": min_sog_kn,
+                    "slab_s": None if slab_minutes is None else slab_minutes * 60.0,
                 },
                 "manoeuvrability": {"alpha": alpha},
             },
@@ -180,6 +216,9 @@ def replay_command(
             quiet=quiet,
             overwrite=overwrite,
             accept_chart_gaps=accept_chart_gaps,
+            workers=workers,
+            scheduler=scheduler,
+            scratch_dir=scratch,
         )
     typer.echo(result.text, nl=False)
     typer.echo(f"Reports in {result.out_dir}")

@@ -36,6 +36,7 @@ import functools
 import math
 import tempfile
 from collections.abc import Sequence
+from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -63,7 +64,7 @@ from .colregs import (
     evaluate_colregs,
 )
 from .encounters import Encounter, encounter_series, velocity_mps
-from .errors import ChartError, NoDataError
+from .errors import ChartError, NoDataError, ParameterError
 from .geo import LocalFrame, sail
 from .manoeuvrability import (
     ManoeuvrabilityAssessment,
@@ -93,7 +94,7 @@ from .rule9 import Finding, PairVerdict, decide_pair, nav_status_finding
 from .slabs import (
     Extent,
     Segmentation,
-    SlabJob,
+    SlabContext,
     SlabResult,
     run_slabs,
     segment_slabs,
@@ -817,6 +818,9 @@ def run_replay(
     overwrite: bool = False,
     accept_chart_gaps: bool = False,
     write: bool = True,
+    workers: int = 1,
+    scheduler: str | None = None,
+    scratch_dir: Path | None = None,
 ) -> ReplayResult:
     """Replay ``ais_paths`` and write the reports (see the module docstring); with
     ``write=False`` nothing is written (the result is in memory only).
@@ -824,63 +828,108 @@ def run_replay(
     Errors: an own MMSI not in the data, fewer than two vessels (``NoDataError``, exit 3); a
     chart that covers none of the AIS (``ChartError``, exit 2); bad files or parameters. A run
     without triggered encounters is not an error: it writes a header-only encounters.csv.
+
+    The run works through time in slabs (``slabs.py``, ``[replay] slab_s``), spilling the
+    decided reports to a scratch directory in ``scratch_dir`` (default: the system's
+    temporary directory). ``workers`` > 1 runs the slabs on a local Dask cluster of that many
+    processes, ``scheduler`` on the Dask cluster at that address (``dask_run.py``).
     """
-    query = load_query(query_path) if query_path is not None else everything_query()
-    params = run_params(query, own_mmsi, overrides)
-    target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
-    if write:
-        check_out_dir(target, overwrite)
-    data = load_ais(ais_paths, query=query, fmt=fmt, quiet=quiet)
-    vessels_in_data = data.positions["mmsi"].nunique()
-    if vessels_in_data < 2:
-        raise NoDataError(
-            f"{', '.join(str(p) for p in ais_paths)}: the AIS selected by query "
-            f"'{query.name}' holds {vessels_in_data} vessel(s); an encounter needs two. "
-            "Widen the query or give more AIS"
+    if workers < 1:
+        raise ParameterError(f"--workers {workers}: give 1 or more worker processes")
+    if scratch_dir is not None and not Path(scratch_dir).is_dir():
+        raise ParameterError(
+            f"--scratch {scratch_dir}: not a directory; give an existing directory (on a "
+            "multi-machine cluster, one that every worker mounts)"
         )
-    source = read_charts(chart_paths, accept_chart_gaps) if chart_paths else None
-    slab_s = params.replay.slab_s
-    with tempfile.TemporaryDirectory(prefix="colregs9-slabs-") as scratch:
-        slabs = slabs_of_frame(data.positions, slab_s)
-        count = len(np.unique(slab_of(data.positions["timestamp"], slab_s)))
-        with progress_bar("tracks (slabs)", count, progress_enabled(quiet)) as bar:
-            segmentation = segment_slabs(slabs, Path(scratch), params.replay, bar)
-        data = dataclasses.replace(data, positions=data.positions.iloc[:0])
-        _check_own(params.own_mmsi, segmentation.vessels)
-        frame = run_frame(query, segmentation.extent, source)
-        chart: Chart | None = None
-        if source is not None:
-            chart = load_run_chart(source, chart_paths, frame, segmentation.points)
-        jobs = slab_jobs(segmentation, frame, params)
-        with progress_bar("pairs (slabs)", len(jobs), progress_enabled(quiet)) as bar:
-            results = run_slabs(jobs, functools.partial(_evaluate, params=params), chart, bar)
-    outcomes = [pair for result in results for pair in result.pairs]
-    ledger = _ledger_with_tracks(data.ledger, segmentation.stats)
-    track_stats = dataclasses.replace(segmentation.stats, samples=sum(r.samples for r in results))
-    counts = _counts(segmentation, results)
-    manifest = build_manifest(
-        query, data, ledger, chart, chart_paths, frame, params, track_stats, counts, tuple(outcomes)
-    )
-    manifest["slabs"] = {
-        "slab_s": slab_s,
-        "slabs": len(jobs),
-        "pairs_followed_past_their_slab": sum(r.followed for r in results),
-    }
-    result = ReplayResult(
-        query_name=query.name,
-        out_dir=target,
-        frame=frame,
-        params=params,
-        pairs=tuple(outcomes),
-        counts=counts,
-        manifest=manifest,
-        files=(),
-    )
-    files: tuple[Path, ...] = ()
-    if write:
-        with progress_bar("reports", len(result.encounters), progress_enabled(quiet)) as bar:
-            files = write_replay_reports(result, chart, plots, bar)
-    return dataclasses.replace(result, files=files, text=format_summary(result))
+    with ExitStack() as stack:
+        cluster = None
+        if workers > 1 or scheduler is not None:
+            # Before the work, so that an unreachable scheduler stops the run at once; only
+            # here, as importing Dask takes a second.
+            from .dask_run import dask_client
+
+            cluster = stack.enter_context(dask_client(workers, scheduler))
+        query = load_query(query_path) if query_path is not None else everything_query()
+        params = run_params(query, own_mmsi, overrides)
+        target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
+        if write:
+            check_out_dir(target, overwrite)
+        data = load_ais(ais_paths, query=query, fmt=fmt, quiet=quiet)
+        vessels_in_data = data.positions["mmsi"].nunique()
+        if vessels_in_data < 2:
+            raise NoDataError(
+                f"{', '.join(str(p) for p in ais_paths)}: the AIS selected by query "
+                f"'{query.name}' holds {vessels_in_data} vessel(s); an encounter needs two. "
+                "Widen the query or give more AIS"
+            )
+        source = read_charts(chart_paths, accept_chart_gaps) if chart_paths else None
+        slab_s = params.replay.slab_s
+        with tempfile.TemporaryDirectory(prefix="colregs9-slabs-", dir=scratch_dir) as scratch:
+            by_slab = slabs_of_frame(data.positions, slab_s)
+            count = len(np.unique(slab_of(data.positions["timestamp"], slab_s)))
+            with progress_bar("tracks (slabs)", count, progress_enabled(quiet)) as bar:
+                segmentation = segment_slabs(by_slab, Path(scratch), params.replay, bar)
+            data = dataclasses.replace(data, positions=data.positions.iloc[:0])
+            _check_own(params.own_mmsi, segmentation.vessels)
+            frame = run_frame(query, segmentation.extent, source)
+            chart: Chart | None = None
+            if source is not None:
+                chart = load_run_chart(source, chart_paths, frame, segmentation.points)
+            context = slab_context(segmentation, frame, params)
+            slabs = slab_range(segmentation, params.replay.slab_s)
+            evaluate = functools.partial(_evaluate, params=params)
+            with progress_bar("pairs (slabs)", len(slabs), progress_enabled(quiet)) as bar:
+                if cluster is None:
+                    results = run_slabs(slabs, context, evaluate, chart, bar)
+                else:
+                    from .dask_run import dask_slabs
+
+                    results = dask_slabs(cluster, slabs, context, evaluate, chart, bar)
+        outcomes = [pair for result in results for pair in result.pairs]
+        ledger = _ledger_with_tracks(data.ledger, segmentation.stats)
+        track_stats = dataclasses.replace(
+            segmentation.stats, samples=sum(r.samples for r in results)
+        )
+        counts = _counts(segmentation, results)
+        manifest = build_manifest(
+            query,
+            data,
+            ledger,
+            chart,
+            chart_paths,
+            frame,
+            params,
+            track_stats,
+            counts,
+            tuple(outcomes),
+        )
+        manifest["slabs"] = {
+            "slab_s": slab_s,
+            "slabs": len(slabs),
+            "workers": "scheduler " + scheduler if scheduler is not None else workers,
+            "pairs_followed_past_their_slab": sum(r.followed for r in results),
+        }
+        result = ReplayResult(
+            query_name=query.name,
+            out_dir=target,
+            frame=frame,
+            params=params,
+            pairs=tuple(outcomes),
+            counts=counts,
+            manifest=manifest,
+            files=(),
+        )
+        files: tuple[Path, ...] = ()
+        if write:
+            with progress_bar("reports", len(result.encounters), progress_enabled(quiet)) as bar:
+                if cluster is None:
+                    files = write_replay_reports(result, chart, plots, bar)
+                else:
+                    from .dask_run import dask_drawer
+
+                    drawer = dask_drawer(cluster)
+                    files = write_replay_reports(result, chart, plots, bar, drawer)
+        return dataclasses.replace(result, files=files, text=format_summary(result))
 
 
 def _evaluate(
@@ -902,28 +951,29 @@ def _check_own(own_mmsi: Sequence[int], vessels: np.ndarray) -> None:
         )
 
 
-def slab_jobs(
-    segmentation: Segmentation, frame: LocalFrame, params: ReplayRunParams
-) -> list[SlabJob]:
-    """One job per slab from the first decided report to the last."""
+def slab_range(segmentation: Segmentation, slab_s: float) -> list[int]:
+    """The slabs from the first decided report's to the last's."""
     if not segmentation.spill.files:
         return []
-    slab_s = params.replay.slab_s
-    first = math.floor(segmentation.first_s / slab_s)
-    last = math.floor(segmentation.last_s / slab_s)
-    return [
-        SlabJob(
-            slab=index,
-            spill=segmentation.spill,
-            statics=segmentation.statics,
-            frame=frame,
-            params=params.replay,
-            course_source=params.colregs.course_source,
-            own_mmsi=params.own_mmsi,
-            data_end_s=segmentation.last_s,
+    return list(
+        range(
+            math.floor(segmentation.first_s / slab_s), math.floor(segmentation.last_s / slab_s) + 1
         )
-        for index in range(first, last + 1)
-    ]
+    )
+
+
+def slab_context(
+    segmentation: Segmentation, frame: LocalFrame, params: ReplayRunParams
+) -> SlabContext:
+    return SlabContext(
+        spill=segmentation.spill,
+        statics=segmentation.statics,
+        frame=frame,
+        params=params.replay,
+        course_source=params.colregs.course_source,
+        own_mmsi=params.own_mmsi,
+        data_end_s=segmentation.last_s,
+    )
 
 
 def verdict_counts(pairs: Sequence[PairOutcome]) -> dict[str, Any]:

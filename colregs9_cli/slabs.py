@@ -235,10 +235,9 @@ PairEvaluator = Callable[[Tracks, Encounter, tuple[int, ...], "Chart | None"], P
 
 
 @dataclass(frozen=True)
-class SlabJob:
-    """Everything one slab needs; no state is shared between slabs."""
+class SlabContext:
+    """What every slab needs, the same for all: sent once to each worker."""
 
-    slab: int
     spill: Spill
     statics: pd.DataFrame
     frame: LocalFrame
@@ -247,12 +246,11 @@ class SlabJob:
     own_mmsi: tuple[int, ...]
     data_end_s: float
 
-    @property
-    def core_steps(self) -> tuple[int, int]:
-        """The grid steps the slab owns (inclusive): those with a time in its core."""
+    def core_steps(self, slab: int) -> tuple[int, int]:
+        """The grid steps a slab owns (inclusive): those with a time in its core."""
         step_s, slab_s = self.params.step_s, self.params.slab_s
-        first = math.ceil(self.slab * slab_s / step_s - 1e-9)
-        last = math.ceil((self.slab + 1) * slab_s / step_s - 1e-9) - 1
+        first = math.ceil(slab * slab_s / step_s - 1e-9)
+        last = math.ceil((slab + 1) * slab_s / step_s - 1e-9) - 1
         return first, last
 
 
@@ -276,7 +274,7 @@ def tail_steps(params: ReplayParams) -> int:
     return math.ceil((2.0 * params.tcpa_act_s + 60.0) / params.step_s)
 
 
-def _tracks(job: SlabJob, steps: tuple[int, int], mmsis: Sequence[int] | None) -> Tracks:
+def _tracks(job: SlabContext, steps: tuple[int, int], mmsis: Sequence[int] | None) -> Tracks:
     """Exact samples at ``steps``: of the vessels under way, or of ``mmsis`` whatever
     their speed."""
     params = job.params
@@ -310,10 +308,12 @@ def _whole(encounter: Encounter, last_step: int, params: ReplayParams) -> bool:
     return encounter.end_step < last_step and _last_needed_step(encounter, params) <= last_step
 
 
-def replay_slab(job: SlabJob, evaluate: PairEvaluator, chart: Chart | None) -> SlabResult:
+def replay_slab(
+    slab: int, job: SlabContext, evaluate: PairEvaluator, chart: Chart | None
+) -> SlabResult:
     """Stage 2 for one slab (see the module docstring)."""
     params = job.params
-    core = job.core_steps
+    core = job.core_steps(slab)
     last_data_step = math.floor(job.data_end_s / params.step_s)
     window = (core[0] - 1, core[1] + tail_steps(params))
     tracks = _tracks(job, window, None)
@@ -339,7 +339,7 @@ def replay_slab(job: SlabJob, evaluate: PairEvaluator, chart: Chart | None) -> S
     for encounter, seats in triggered_pairs(encounters):
         pairs.append(evaluate(by_id[encounter.encounter_id], encounter, seats, chart))
     return SlabResult(
-        slab=job.slab,
+        slab=slab,
         pairs=tuple(pairs),
         candidate_pair_steps=search.candidate_pair_steps,
         candidate_pairs=frozenset(
@@ -358,7 +358,7 @@ def replay_slab(job: SlabJob, evaluate: PairEvaluator, chart: Chart | None) -> S
 
 
 def _follow(
-    job: SlabJob, encounter: Encounter, window: tuple[int, int]
+    job: SlabContext, encounter: Encounter, window: tuple[int, int]
 ) -> list[tuple[Encounter, Tracks]]:
     """The encounter as far as it goes, in each of its seats: its two vessels alone, in
     windows that double."""
@@ -393,14 +393,15 @@ def triggered_pairs(
 
 
 def run_slabs(
-    jobs: Sequence[SlabJob],
+    slabs: Sequence[int],
+    context: SlabContext,
     evaluate: PairEvaluator,
     chart: Chart | None,
     bar: ProgressSink,
 ) -> list[SlabResult]:
-    """Stage 2 over ``jobs`` in this process, in order."""
+    """Stage 2 over ``slabs`` in this process, in slab order."""
     results = []
-    for job in jobs:
-        results.append(replay_slab(job, evaluate, chart))
+    for slab in slabs:
+        results.append(replay_slab(slab, context, evaluate, chart))
         bar.advance()
     return results

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable, Sequence
 from datetime import datetime
 from enum import Enum
 from pathlib import Path
@@ -433,16 +434,42 @@ def format_index(result: ReplayResult, plots: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
+def draw_encounter(
+    outcome: EncounterOutcome, target: Path, chart: Chart | None, ukc_m: float
+) -> Path:
+    """One encounter's figure, saved to ``target``."""
+    figure = encounter_figure(outcome, chart, ukc_m)
+    try:
+        save_figure(target, figure, dpi=120)
+    finally:
+        plt.close(figure)
+    return target
+
+
+FigureJobs = Sequence[tuple[EncounterOutcome, Path]]
+# Draws the figures of ``FigureJobs`` (chart, UKC), advancing the progress sink once each.
+Drawer = Callable[[FigureJobs, "Chart | None", float, "ProgressSink"], None]
+
+
+def draw_here(jobs: FigureJobs, chart: Chart | None, ukc_m: float, progress: ProgressSink) -> None:
+    """The figures drawn one after the other in this process."""
+    for outcome, target in jobs:
+        draw_encounter(outcome, target, chart, ukc_m)
+        progress.advance()
+
+
 def write_replay_reports(
     result: ReplayResult,
     chart: Chart | None,
     plots: bool,
     progress: ProgressSink,
+    drawer: Drawer = draw_here,
 ) -> tuple[Path, ...]:
     """Write every report file into ``result.out_dir``, which is replaced whole (no file of
-    an earlier run stays); returns the paths written."""
+    an earlier run stays); returns the paths written. ``drawer`` draws the figures (here, or
+    on the workers of a cluster: ``dask_run.dask_drawer``)."""
     with report_directory(result.out_dir) as staging:
-        written = _write_replay_files(result, staging, chart, plots, progress)
+        written = _write_replay_files(result, staging, chart, plots, progress, drawer)
     return tuple(result.out_dir / path.relative_to(staging) for path in written)
 
 
@@ -452,22 +479,23 @@ def _write_replay_files(
     chart: Chart | None,
     plots: bool,
     progress: ProgressSink,
+    drawer: Drawer,
 ) -> tuple[Path, ...]:
     series_dir = out_dir / ENCOUNTER_DIR
     files: list[Path] = []
+    figures: list[tuple[EncounterOutcome, Path]] = []
     for outcome in result.encounters:
         target = series_dir / f"{outcome.summary.encounter_id}.csv"
         write_csv(target, _lowercase_booleans(outcome.series))
         files.append(target)
         if plots:
-            figure = encounter_figure(outcome, chart, result.params.manoeuvrability.ukc_m)
-            try:
-                png = series_dir / f"{outcome.summary.encounter_id}.png"
-                save_figure(png, figure, dpi=120)
-                files.append(png)
-            finally:
-                plt.close(figure)
-        progress.advance()
+            png = series_dir / f"{outcome.summary.encounter_id}.png"
+            figures.append((outcome, png))
+            files.append(png)
+        else:
+            progress.advance()
+    if figures:
+        drawer(figures, chart, result.params.manoeuvrability.ukc_m, progress)
     encounters_csv = out_dir / ENCOUNTERS_NAME
     encounters_table = _lowercase_booleans(encounters_frame(result.encounters))
     write_csv(encounters_csv, encounters_table)

@@ -1,0 +1,107 @@
+"""Stage 2 of the replay (``slabs.replay_slab``) on dask.distributed (DESIGN §6).
+
+A ``LocalCluster`` of ``workers`` processes (one thread each: the work is NumPy and pandas
+under the GIL) by default, or the cluster whose scheduler is at ``scheduler``. The slabs'
+shared context and the chart are sent to the workers once; each slab is one task, and the
+results are put back in slab order, so that they do not depend on the number of workers.
+
+On a cluster of several machines every worker must read the run's scratch directory (the
+spilled reports): give ``--scratch`` on a file system they all mount.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+
+from distributed import Client, LocalCluster, as_completed
+
+from .chart import Chart
+from .errors import ParameterError
+from .progress import ProgressSink
+from .replay_results import EncounterOutcome
+from .report.replay_report import Drawer, draw_encounter
+from .slabs import PairEvaluator, SlabContext, SlabResult, replay_slab
+
+# How long to wait for a scheduler given with --scheduler before giving up.
+_CONNECT_TIMEOUT_S = 10
+
+
+@contextmanager
+def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
+    """A client of the cluster at ``scheduler``, else of a new local cluster."""
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout=_CONNECT_TIMEOUT_S)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise ParameterError(
+                f"--scheduler {scheduler}: cannot reach a Dask scheduler there ({exc}); start "
+                "one (dask scheduler) or leave out --scheduler to use a local cluster"
+            ) from None
+        with client:
+            yield client
+        return
+    with (
+        LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        ) as cluster,
+        Client(cluster) as client,
+    ):
+        yield client
+
+
+def dask_slabs(
+    client: Client,
+    slabs: Sequence[int],
+    context: SlabContext,
+    evaluate: PairEvaluator,
+    chart: Chart | None,
+    bar: ProgressSink,
+) -> list[SlabResult]:
+    """``slabs.replay_slab`` for every slab on the cluster of ``client``, in slab order."""
+    shared = client.scatter([context, chart], broadcast=True)
+    futures = client.map(
+        replay_slab,
+        list(slabs),
+        job=shared[0],
+        evaluate=evaluate,
+        chart=shared[1],
+        pure=False,
+    )
+    results: list[SlabResult] = []
+    for future in as_completed(futures):
+        results.append(future.result())
+        bar.advance()
+    return sorted(results, key=lambda result: result.slab)
+
+
+def dask_drawer(client: Client) -> Drawer:
+    """A ``replay_report.Drawer`` that draws each figure as a task on the cluster (the
+    workers write into the report's staging directory)."""
+
+    def draw(
+        jobs: Sequence[tuple[EncounterOutcome, Path]],
+        chart: Chart | None,
+        ukc_m: float,
+        progress: ProgressSink,
+    ) -> None:
+        (shared,) = client.scatter([chart], broadcast=True)
+        futures = client.map(
+            draw_encounter,
+            [outcome for outcome, _ in jobs],
+            [target for _, target in jobs],
+            chart=shared,
+            ukc_m=ukc_m,
+            pure=False,
+        )
+        for future in as_completed(futures):
+            future.result()
+            progress.advance()
+
+    return draw

@@ -1,0 +1,84 @@
+"""``replay --workers`` and ``--scheduler`` on dask.distributed: the same results for any
+number of workers, and clear errors."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from colregs9_cli import dask_run
+from colregs9_cli.cli import app
+
+from fixture_files import NMEA
+
+
+def _replay(out: Path, *options: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [
+            *(sys.executable, "-m", "colregs9_cli", "replay", str(NMEA), "--quiet"),
+            *("--out", str(out), "--slab-minutes", "1", *options),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+
+
+def _report_files(out: Path) -> dict[str, bytes]:
+    return {
+        str(path.relative_to(out)): path.read_bytes()
+        for path in sorted(out.rglob("*"))
+        if path.is_file() and path.name not in ("run.json", "report.gpkg")
+    }
+
+
+def test_two_workers_write_what_one_writes(tmp_path: Path) -> None:
+    """A LocalCluster of two processes, figures included: the same files, byte for byte,
+    the encounters in the same order, and nothing on stderr."""
+    one = _replay(tmp_path / "one")
+    two = _replay(tmp_path / "two", "--workers", "2")
+    assert one.returncode == 0, one.stderr
+    assert two.returncode == 0, two.stderr
+    assert two.stderr == ""
+    files = _report_files(tmp_path / "one")
+    assert sum(name.endswith(".png") for name in files) == 24
+    assert _report_files(tmp_path / "two") == files
+    assert one.stdout.replace(str(tmp_path / "one"), "") == two.stdout.replace(
+        str(tmp_path / "two"), ""
+    )
+
+
+def test_an_unreachable_scheduler_is_one_error_before_any_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(dask_run, "_CONNECT_TIMEOUT_S", 1)
+    result = CliRunner().invoke(
+        app,
+        [
+            *("replay", str(NMEA), "--quiet", "--out", str(tmp_path / "r")),
+            *("--scheduler", "tcp://127.0.0.1:9"),
+        ],
+    )
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error: --scheduler tcp://127.0.0.1:9")
+    assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--workers", "0"], "--workers 0"),
+        (["--scratch", "/nonexistent/scratch"], "--scratch /nonexistent/scratch"),
+    ],
+)
+def test_bad_worker_options_are_one_error(tmp_path: Path, options, message) -> None:
+    result = CliRunner().invoke(
+        app, ["replay", str(NMEA), "--quiet", "--out", str(tmp_path / "r"), *options]
+    )
+    assert result.exit_code == 2, result.output
+    assert result.output.startswith(f"Error: {message}")
