@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pyproj import Geod
+from pyproj import Geod, Proj
 
 from colregs9_cli.geo import LocalFrame
 
@@ -75,3 +75,18 @@ def test_unknown_positions_and_bearings_stay_unknown() -> None:
     assert np.isnan(FRAME.true_to_grid_deg(np.nan, 56.0, 13.0))
     assert FRAME.grid_convergence_deg([], []).shape == (0,)
     assert FRAME.grid_convergence_deg(56.0, [9.0, 13.0]).shape == (2,)
+
+
+@pytest.mark.parametrize("lat0", [0.0, 56.0, 78.0, -45.0])
+def test_convergence_series_agrees_with_proj_everywhere(lat0: float) -> None:
+    """The closed-form series near the central meridian and PROJ's get_factors beyond it
+    give the same convergence, across the antimeridian too."""
+    frame = LocalFrame(lat0, 175.0)
+    lat, lon = np.meshgrid(np.linspace(-85.0, 85.0, 35), np.linspace(150.0, 200.0, 101))
+    lon = (lon.ravel() + 180.0) % 360.0 - 180.0
+    lat = lat.ravel()
+    got = frame.grid_convergence_deg(lat, lon)
+    factors = Proj(frame.crs).get_factors(lon, lat)
+    expected = np.asarray(factors.meridian_convergence, dtype=float)
+    assert np.abs(got - expected).max() < 2e-5
+    assert np.isnan(frame.grid_convergence_deg(np.nan, 10.0))
