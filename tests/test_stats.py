@@ -240,6 +240,7 @@ def test_reports_lay_out_the_table(tmp_path: Path) -> None:
         "dimension_stats.csv",
         "dimension_stats.md",
         "dimension_histograms.png",
+        "index.html",
         "run.json",
     ]
     assert (tmp_path / "out" / "dimension_stats.csv").read_text().splitlines()[0] == (

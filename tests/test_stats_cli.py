@@ -32,7 +32,13 @@ LIMFJORD_BOX = (56.5, 57.2, 8.2, 10.4)
 
 DIMENSIONS = ["length_m", "breadth_m", "draught_m"]
 CSV_HEADER = "dimension,count,mean,median,std,min,max"
-REPORT_FILES = {"dimension_stats.csv", "dimension_stats.md", "dimension_histograms.png", "run.json"}
+REPORT_FILES = {
+    "dimension_stats.csv",
+    "dimension_stats.md",
+    "dimension_histograms.png",
+    "index.html",
+    "run.json",
+}
 
 
 def _valid_mmsi(mmsi: pd.Series) -> pd.Series:

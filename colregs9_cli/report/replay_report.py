@@ -34,6 +34,7 @@ from ..replay_results import (
 )
 from .atomic import report_directory, save_figure, write_csv, write_json, write_text
 from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart
+from .html_report import HTML_NAME, replay_html
 from .replay_geopackage import GEOPACKAGE_NAME, write_replay_geopackage
 
 if TYPE_CHECKING:
@@ -406,6 +407,8 @@ def format_index(result: ReplayResult, plots: bool) -> str:
         f"- `{ENCOUNTER_DIR}/`: each triggered encounter's time series (CSV)"
         + (" and figure (PNG)." if plots else "."),
         f"- [{MANIFEST_NAME}]({MANIFEST_NAME}): inputs, parameters, rejects ledger and counts.",
+        f"- [{HTML_NAME}]({HTML_NAME}): this report as a web page, with a map and a table "
+        "to sort and filter.",
         "",
     ]
     if not result.pairs:
@@ -506,6 +509,8 @@ def _write_replay_files(
     write_csv(pairs_csv, _lowercase_booleans(pairs_frame(result.pairs)))
     index = out_dir / INDEX_NAME
     write_text(index, format_index(result, plots))
+    page = out_dir / HTML_NAME
+    write_text(page, replay_html(result, chart, plots, ENCOUNTER_DIR))
     manifest = out_dir / MANIFEST_NAME
     write_json(manifest, result.manifest)
-    return (pairs_csv, encounters_csv, *files, index, manifest)
+    return (pairs_csv, encounters_csv, *files, index, page, manifest)

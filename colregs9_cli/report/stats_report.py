@@ -15,6 +15,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from .atomic import report_directory, save_figure, write_csv, write_json, write_text
+from .html_report import HTML_NAME, stats_html
 from .manifest import inputs_manifest, query_manifest, run_header
 
 if TYPE_CHECKING:
@@ -165,13 +166,25 @@ def build_manifest(result: StatsResult, query: Query, data: AisData) -> dict[str
 def write_stats_reports(
     out_dir: Path, result: StatsResult, query_name: str, manifest: dict[str, Any]
 ) -> tuple[Path, ...]:
-    """Write the four report files into ``out_dir``, which is replaced whole; returns their
+    """Write the five report files into ``out_dir``, which is replaced whole; returns their
     paths."""
-    names = (CSV_NAME, MARKDOWN_NAME, HISTOGRAM_NAME, MANIFEST_NAME)
+    names = (CSV_NAME, MARKDOWN_NAME, HISTOGRAM_NAME, HTML_NAME, MANIFEST_NAME)
     with report_directory(out_dir) as staging:
-        csv_path, markdown_path, histogram_path, manifest_path = (staging / n for n in names)
-        write_csv(csv_path, result.to_frame())
+        csv_path, markdown_path, histogram_path, html_path, manifest_path = (
+            staging / n for n in names
+        )
+        table = result.to_frame()
+        write_csv(csv_path, table)
         write_text(markdown_path, format_markdown(result, query_name))
         save_figure(histogram_path, histogram_figure(result, query_name), dpi=110)
+        write_text(
+            html_path,
+            stats_html(
+                _title(result, query_name),
+                [("Dimension statistics", table)],
+                [HISTOGRAM_NAME],
+                [CSV_NAME, MARKDOWN_NAME, MANIFEST_NAME],
+            ),
+        )
         write_json(manifest_path, manifest)
     return tuple(out_dir / name for name in names)

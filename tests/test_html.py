@@ -1,0 +1,105 @@
+"""The HTML reports, loaded in a real browser (Debian's headless Chromium, ``--dump-dom``):
+the rendered page must hold the table rows, the map and every figure."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from colregs9_cli.replay import run_replay
+from colregs9_cli.stats import run_stats
+
+from fixture_files import DMA26, SANDIEGO_AIS, SANDIEGO_ENC
+
+CHROMIUM_FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--virtual-time-budget=5000",
+    "--dump-dom",
+)
+
+
+def rendered(page: Path, tmp_path: Path, query: str = "") -> str:
+    """The page's DOM after its scripts ran, as Chromium rendered it (no network)."""
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    assert browser, "Chromium is needed for the browser tests: apt-get install chromium"
+    profile = tmp_path / f"chromium-profile-{len(query)}"
+    result = subprocess.run(
+        [browser, *CHROMIUM_FLAGS, f"--user-data-dir={profile}", page.as_uri() + query],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    return result.stdout
+
+
+@pytest.fixture(scope="module")
+def sandiego_report(tmp_path_factory: pytest.TempPathFactory):
+    out = tmp_path_factory.mktemp("html") / "report"
+    result = run_replay([SANDIEGO_AIS], [SANDIEGO_ENC], out_dir=out, plots=True)
+    return result, out
+
+
+def _rows(dom: str) -> list[str]:
+    body = dom[dom.index('<table class="sortable" id="encounters">') :]
+    body = body[body.index("<tbody>") : body.index("</tbody>")]
+    return re.findall(r"<tr( class=\"hidden\")?>", body)
+
+
+def test_replay_page_shows_every_encounter_and_figure(sandiego_report, tmp_path) -> None:
+    result, out = sandiego_report
+    page = out / "index.html"
+    # Nothing is fetched from the network (the SVG's namespace names are not fetched).
+    assert not re.search(r'(src|href|url)\s*[=(]\s*["\']?https?:', page.read_text())
+    dom = rendered(page, tmp_path)
+    assert len(_rows(dom)) == len(result.encounters) == 38
+    # Every figure loaded: the page replaces one that does not with a "missing" note.
+    assert dom.count('class="figure"') == 38
+    assert 'class="missing"' not in dom
+    assert dom.count('<section class="encounter"') == 38
+    assert "<svg" in dom  # the overview map, drawn inline
+    for outcome in result.encounters:
+        assert f'href="#enc-{outcome.summary.encounter_id}"' in dom
+
+
+def test_replay_page_filters_and_sorts_in_the_browser(sandiego_report, tmp_path) -> None:
+    result, out = sandiego_report
+    head_on = sum(o.summary.situation.value == "head-on" for o in result.encounters)
+    assert 0 < head_on < len(result.encounters)
+    dom = rendered(out / "index.html", tmp_path, "?q=head-on&sort=9")
+    rows = _rows(dom)
+    assert sum(hidden == "" for hidden in rows) == head_on
+    assert f'<span id="encounters-shown">{head_on}</span>' in dom
+    cpas = [float(v) for v in re.findall(r'<td class="num" data-value="([^"]+)">', dom)[::2]]
+    assert cpas == sorted(cpas)
+
+
+def test_a_missing_figure_is_marked_not_broken(sandiego_report, tmp_path) -> None:
+    _, out = sandiego_report
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    first = sorted((copy / "encounters").glob("*.png"))[0]
+    first.unlink()
+    dom = rendered(copy / "index.html", tmp_path)
+    assert dom.count('class="missing"') == 1
+    assert f"figure not found: encounters/{first.name}" in dom
+
+
+def test_stats_page_shows_its_table_and_histograms(tmp_path) -> None:
+    run = run_stats([DMA26], out_dir=tmp_path / "stats")
+    dom = rendered(tmp_path / "stats" / "index.html", tmp_path)
+    body = dom[dom.index("<tbody>") : dom.index("</tbody>")]
+    assert body.count("<tr") == len(run.result.to_frame()) == 3
+    assert dom.count('class="figure"') == 1
+    assert 'class="missing"' not in dom
