@@ -20,6 +20,7 @@ from distributed import Client, LocalCluster, as_completed
 
 from .chart import Chart
 from .errors import ParameterError
+from .geo import LocalFrame
 from .progress import ProgressSink
 from .replay_results import EncounterOutcome
 from .report.replay_report import Drawer, draw_encounter
@@ -89,6 +90,7 @@ def dask_drawer(client: Client) -> Drawer:
         jobs: Sequence[tuple[EncounterOutcome, Path]],
         chart: Chart | None,
         ukc_m: float,
+        frame: LocalFrame,
         progress: ProgressSink,
     ) -> None:
         (shared,) = client.scatter([chart], broadcast=True)
@@ -98,6 +100,7 @@ def dask_drawer(client: Client) -> Drawer:
             [target for _, target in jobs],
             chart=shared,
             ukc_m=ukc_m,
+            frame=frame,
             pure=False,
         )
         for future in as_completed(futures):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import re
@@ -169,13 +170,13 @@ def test_png_smoke_render(run) -> None:
 
 def test_figure_plots_the_tracks_and_the_positions_at_tcpa(run) -> None:
     (outcome,) = run.encounters
-    figure = encounter_figure(outcome, chart=None, ukc_m=0.5)
+    figure = encounter_figure(outcome, chart=None, ukc_m=0.5, frame=run.frame)
     (ax,) = figure.axes  # no chart, no colour bar
     lines = {line.get_label(): line for line in ax.get_lines()}
-    own = lines[f"own ship {OWN}"]
+    own = _by_gid(ax, "own-track")
     np.testing.assert_allclose(own.get_xdata(), outcome.own_track["east_m"])
     np.testing.assert_allclose(own.get_ydata(), outcome.own_track["north_m"])
-    target = lines[f"target {outcome.summary.target_mmsi}"]
+    target = _by_gid(ax, "target-track")
     np.testing.assert_allclose(target.get_ydata(), outcome.target_track["north_m"])
     # The paper's dots: own ship red, target black; own ship's track is not the restricted red.
     own_dot = lines["own ship at TCPA"]
@@ -206,6 +207,11 @@ def restricted(tmp_path_factory: pytest.TempPathFactory):
     )
 
 
+def _by_gid(ax, gid: str):
+    (found,) = [line for line in ax.get_lines() if line.get_gid() == gid]
+    return found
+
+
 def _collection(ax, gid: str):
     found = [c for c in ax.collections if c.get_gid() == gid]
     return found[0] if found else None
@@ -215,7 +221,7 @@ def test_figure_draws_one_ellipse_per_projected_position(restricted) -> None:
     (outcome,) = restricted.encounters
     assessment = outcome.assessment
     chart = load_chart([MODELLED_CHART], restricted.frame)
-    figure = encounter_figure(outcome, chart, ukc_m=0.0)
+    figure = encounter_figure(outcome, chart, ukc_m=0.0, frame=restricted.frame)
     ax, colour_bar = figure.axes
     assert colour_bar.get_ylabel() == DEPTH_LABEL
     red = _collection(ax, "restricted-ellipses")
@@ -234,7 +240,7 @@ def test_figure_draws_one_ellipse_per_projected_position(restricted) -> None:
 
 def test_figure_without_a_chart_marks_every_ellipse_unknown(run) -> None:
     (outcome,) = run.encounters
-    figure = encounter_figure(outcome, chart=None, ukc_m=0.0)
+    figure = encounter_figure(outcome, chart=None, ukc_m=0.0, frame=run.frame)
     (ax,) = figure.axes
     unknown = _collection(ax, "unknown-ellipses")
     assert len(unknown.get_paths()) == len(outcome.assessment.arc)
@@ -245,7 +251,7 @@ def test_figure_without_a_chart_marks_every_ellipse_unknown(run) -> None:
 def test_figure_marks_both_vessels_at_the_trigger(run) -> None:
     (outcome,) = run.encounters
     s = outcome.summary
-    figure = encounter_figure(outcome, chart=None, ukc_m=0.0)
+    figure = encounter_figure(outcome, chart=None, ukc_m=0.0, frame=run.frame)
     (ax,) = figure.axes
     lines = {line.get_label(): line for line in ax.get_lines()}
     first = outcome.series.iloc[0]
@@ -290,7 +296,7 @@ def test_direction_arrows_on_a_hand_worked_track() -> None:
 
 def test_figure_arrows_show_the_direction_of_travel(run) -> None:
     (outcome,) = run.encounters
-    figure = encounter_figure(outcome, chart=None, ukc_m=0.0)
+    figure = encounter_figure(outcome, chart=None, ukc_m=0.0, frame=run.frame)
     (ax,) = figure.axes
     for gid, track in (
         ("own-direction", outcome.own_track),
@@ -315,7 +321,7 @@ def test_figure_arrows_show_the_direction_of_travel(run) -> None:
 def test_figure_layout_keeps_the_plot_clear(restricted) -> None:
     (outcome,) = restricted.encounters
     chart = load_chart([MODELLED_CHART], restricted.frame)
-    figure = encounter_figure(outcome, chart, ukc_m=0.0)
+    figure = encounter_figure(outcome, chart, ukc_m=0.0, frame=restricted.frame)
     ax = figure.axes[0]
     # A colour bar keys the depth shading.
     depths = _collection(ax, "depth-areas")
@@ -330,7 +336,70 @@ def test_figure_layout_keeps_the_plot_clear(restricted) -> None:
     labels = [t.get_text() for t in legend.get_texts()]
     assert {"own ship at trigger", "target at trigger", "restricted ellipses"} <= set(labels)
     # The ellipses are drawn over the tracks.
-    lines = {line.get_label(): line for line in ax.get_lines()}
-    track_zorder = lines[f"own ship {GREENHOPPER}"].get_zorder()
+    track_zorder = _by_gid(ax, "own-track").get_zorder()
     assert _collection(ax, "restricted-ellipses").get_zorder() > track_zorder
     assert _collection(ax, "clear-ellipses").get_zorder() > track_zorder
+
+
+def test_figure_names_the_vessels_and_marks_defaulted_dimensions(restricted) -> None:
+    (outcome,) = restricted.encounters
+    s = outcome.summary
+    chart = load_chart([MODELLED_CHART], restricted.frame)
+    figure = encounter_figure(outcome, chart, ukc_m=0.0, frame=restricted.frame)
+    ax = figure.axes[0]
+    own = _by_gid(ax, "own-track").get_label()
+    target = _by_gid(ax, "target-track").get_label()
+    assert str(s.own_mmsi) in own and str(s.target_mmsi) in target
+    assert f"{s.target_length_m:.3g}" in target and f"T {s.target_draught_m:.3g}" in target
+    for label, defaulted in (
+        (own, s.own_dimensions_defaulted),
+        (target, s.target_dimensions_defaulted),
+    ):
+        assert ("*" in label) == bool(defaulted)
+    at_cpa = s.trigger_utc + pd.Timedelta(seconds=s.tcpa_s)
+    assert f"{s.trigger_utc:%H:%M:%S} UTC" in ax.get_title()
+    assert f"CPA predicted at {at_cpa:%H:%M:%S}" in ax.get_title()
+
+
+def test_figure_axes_read_latitude_and_longitude_with_a_scale_bar(restricted) -> None:
+    (outcome,) = restricted.encounters
+    frame = restricted.frame
+    figure = encounter_figure(outcome, None, ukc_m=0.0, frame=frame)
+    ax = figure.axes[0]
+    figure.canvas.draw()
+    (x_low, x_high), (y_low, y_high) = ax.get_xlim(), ax.get_ylim()
+    middle_north, middle_east = (y_low + y_high) / 2, (x_low + x_high) / 2
+    for tick in ax.get_xticklabels():
+        if not tick.get_text():
+            continue
+        lon = frame.to_geodetic(middle_north, tick.get_position()[0])[1]
+        assert tick.get_text() == f"{abs(float(lon)):.4f}°E"
+    for tick in ax.get_yticklabels():
+        if not tick.get_text():
+            continue
+        lat = frame.to_geodetic(tick.get_position()[1], middle_east)[0]
+        assert tick.get_text() == f"{float(lat):.4f}°N"
+    assert [a for a in ax.artists if a.get_gid() == "scale-bar"]
+    # Half-transparent ellipses keep the tracks visible.
+    ellipses = [
+        _collection(ax, gid)
+        for gid in ("restricted-ellipses", "clear-ellipses", "unknown-ellipses")
+        if _collection(ax, gid) is not None
+    ]
+    assert ellipses and all(0 < c.get_alpha() < 1 for c in ellipses)
+
+
+def test_figure_marks_where_the_data_ends_before_cpa(run) -> None:
+    (outcome,) = run.encounters
+    stopped = dataclasses.replace(
+        outcome, summary=dataclasses.replace(outcome.summary, data_covers_cpa=False)
+    )
+    ax = encounter_figure(stopped, None, ukc_m=0.0, frame=run.frame).axes[0]
+    end = _by_gid(ax, "own-ship-data-end")
+    assert end.get_xdata()[0] == outcome.own_track["east_m"].dropna().iloc[-1]
+    assert _by_gid(ax, "target-data-end")
+    covered = dataclasses.replace(
+        outcome, summary=dataclasses.replace(outcome.summary, data_covers_cpa=True)
+    )
+    ax = encounter_figure(covered, None, ukc_m=0.0, frame=run.frame).axes[0]
+    assert not [line for line in ax.get_lines() if "data-end" in str(line.get_gid())]

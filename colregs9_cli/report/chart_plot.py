@@ -23,9 +23,12 @@ from matplotlib.collections import PatchCollection
 from matplotlib.colors import ListedColormap
 from matplotlib.patches import PathPatch
 from matplotlib.path import Path as MplPath
+from matplotlib.ticker import FuncFormatter, MaxNLocator
+from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
 if TYPE_CHECKING:
     from ..chart import Chart
+    from ..geo import LocalFrame
     from ..manoeuvrability import ManoeuvrabilityAssessment
 
 LAND_COLOUR = "#d9c7a0"
@@ -41,7 +44,9 @@ DEPTH_LABEL = "DRVAL1, shallowest depth (m)"
 ELLIPSE_ZORDER = 3.0
 RESTRICTED_ZORDER = 3.2
 ARC_ZORDER = 4.0
-ELLIPSE_LINEWIDTH = 0.8
+ELLIPSE_LINEWIDTH = 0.6
+# Ellipses are half transparent, so that the tracks under them stay visible.
+ELLIPSE_ALPHA = 0.45
 
 
 def _ring_path(coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -159,8 +164,50 @@ def draw_assessment(ax: Axes, assessment: ManoeuvrabilityAssessment) -> None:
             continue
         patches, _ = _patches(assessment.ellipses[selected])
         ellipses = PatchCollection(
-            patches, facecolor="none", edgecolor=colour, linewidth=ELLIPSE_LINEWIDTH, zorder=zorder
+            patches,
+            facecolor="none",
+            edgecolor=colour,
+            linewidth=ELLIPSE_LINEWIDTH,
+            alpha=ELLIPSE_ALPHA,
+            zorder=zorder,
         )
         ellipses.set_gid(gid)
         ellipses.set_label(gid.replace("-", " "))
         ax.add_collection(ellipses)
+
+
+def geographic_axes(ax: Axes, frame: LocalFrame) -> None:
+    """Label the axes of a local-frame plot in latitude and longitude (read at the middle of
+    the view: exact there, and within a small fraction of a tick across a harbour-sized
+    view) and add a scale bar, so that the metres of the frame never reach the reader."""
+    (x_low, x_high), (y_low, y_high) = ax.get_xlim(), ax.get_ylim()
+    middle_east, middle_north = (x_low + x_high) / 2.0, (y_low + y_high) / 2.0
+
+    def longitude(east_m: float, _: int) -> str:
+        lon = frame.to_geodetic(middle_north, east_m)[1]
+        return f"{abs(float(lon)):.4f}°{'E' if lon >= 0 else 'W'}"
+
+    def latitude(north_m: float, _: int) -> str:
+        lat = frame.to_geodetic(north_m, middle_east)[0]
+        return f"{abs(float(lat)):.4f}°{'N' if lat >= 0 else 'S'}"
+
+    ax.xaxis.set_major_formatter(FuncFormatter(longitude))
+    ax.yaxis.set_major_formatter(FuncFormatter(latitude))
+    ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
+    ax.yaxis.set_major_locator(MaxNLocator(nbins=6))
+    ax.tick_params(axis="x", labelrotation=20)
+    ax.set_xlabel("longitude")
+    ax.set_ylabel("latitude")
+    length_m = _round_length(0.25 * (x_high - x_low))
+    label = f"{length_m / 1000:g} km" if length_m >= 1000 else f"{length_m:g} m"
+    bar = AnchoredSizeBar(
+        ax.transData, length_m, label, "lower left", pad=0.4, frameon=True, size_vertical=0
+    )
+    bar.set_gid("scale-bar")
+    ax.add_artist(bar)
+
+
+def _round_length(length_m: float) -> float:
+    """1, 2 or 5 times a power of ten, at most ``length_m``."""
+    power = 10.0 ** np.floor(np.log10(max(length_m, 1.0)))
+    return float(max(m * power for m in (1.0, 2.0, 5.0) if m * power <= max(length_m, 1.0)))

@@ -15,6 +15,7 @@ import io
 from collections.abc import Iterable, Sequence
 from typing import TYPE_CHECKING, Any
 
+import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
@@ -286,7 +287,9 @@ def overview_svg(result: ReplayResult, chart: Chart | None) -> str:
             ax.legend(loc="best", fontsize="small")
         ax.set_title(f"{len(result.pairs)} triggered pairs at their trigger positions")
         buffer = io.StringIO()
-        figure.savefig(buffer, format="svg", bbox_inches="tight")
+        # No date and fixed element ids: the same run gives the same page.
+        with matplotlib.rc_context({"svg.hashsalt": "colregs9"}):
+            figure.savefig(buffer, format="svg", bbox_inches="tight", metadata={"Date": None})
     finally:
         plt.close(figure)
     svg = buffer.getvalue()

@@ -33,12 +33,13 @@ from ..replay_results import (
     ReplayResult,
 )
 from .atomic import report_directory, save_figure, write_csv, write_json, write_text
-from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart
+from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart, geographic_axes
 from .html_report import HTML_NAME, replay_html
 from .replay_geopackage import GEOPACKAGE_NAME, write_replay_geopackage
 
 if TYPE_CHECKING:
     from ..chart import Chart
+    from ..geo import LocalFrame
     from ..progress import ProgressSink
 
 ENCOUNTERS_NAME = "encounters.csv"
@@ -257,6 +258,7 @@ def _draw_track(
         linestyle=linestyle,
         zorder=TRACK_ZORDER,
         label=name,
+        gid=gid.replace("direction", "track"),
     )
     east, north, unit_east, unit_north = direction_arrows(track)
     if len(east):
@@ -322,15 +324,15 @@ def _draw_positions(
 
 
 def _legend_below(figure: Figure, ax: Any) -> None:
-    """A compact legend under the axes, so that it covers nothing: one column for own ship,
-    one for the target, and two for the chart and the assessment."""
+    """A compact legend under the axes, so that it covers nothing: own ship, then the arcs
+    and the water, in one column; the target, then the ellipses, in the other."""
     handles, labels = ax.get_legend_handles_labels()
     entries = list(zip(handles, labels, strict=True))
     own = [e for e in entries if e[1].startswith("own ship")]
     target = [e for e in entries if e[1].startswith("target")]
     arcs_and_water = [e for e in entries if e[1].endswith("arc") or e[1].startswith("navigable")]
     ellipses = [e for e in entries if e[1].endswith("ellipses")]
-    columns = [c for c in (own, target, arcs_and_water, ellipses) if c]
+    columns = [own + arcs_and_water, target + ellipses]
     rows = max(len(c) for c in columns)
     blank = (Line2D([], [], linestyle="none"), "")
     # matplotlib fills a legend column by column: pad each to the same height.
@@ -339,38 +341,85 @@ def _legend_below(figure: Figure, ax: Any) -> None:
         [h for h, _ in padded],
         [label for _, label in padded],
         loc="outside lower center",
-        ncols=len(columns),
+        ncols=2,
         fontsize="small",
         frameon=False,
     )
 
 
-def encounter_figure(outcome: EncounterOutcome, chart: Chart | None, ukc_m: float) -> Figure:
-    """The paper's result figure for one encounter, in the run's local frame (east, north).
+def _vessel_label(role: str, name: str | None, mmsi: int, dims: tuple[Any, ...]) -> str:
+    """``own ship NAME (MMSI), 50 × 9 m, T 3.2 m`` with ``*`` on dimensions defaulted."""
+    length_m, breadth_m, draught_m, defaulted = dims
+    marked = set(str(defaulted or "").split(";"))
+
+    def value(name: str, metres: float) -> str:
+        return f"{metres:.3g}{'*' if name in marked else ''}"
+
+    who = f"{name} ({mmsi})" if name else str(mmsi)
+    return (
+        f"{role} {who}, {value('length_m', length_m)} × {value('breadth_m', breadth_m)} m, "
+        f"T {value('draught_m', draught_m)} m"
+    )
+
+
+def _mark_data_end(ax: Any, track: pd.DataFrame, colour: str, role: str) -> None:
+    """An × where a track's data stops before the closest approach."""
+    east = track["east_m"].to_numpy(dtype=float)
+    north = track["north_m"].to_numpy(dtype=float)
+    known = np.isfinite(east) & np.isfinite(north)
+    if known.any():
+        last = np.flatnonzero(known)[-1]
+        ax.plot(
+            east[last],
+            north[last],
+            "x",
+            color=colour,
+            markersize=10,
+            markeredgewidth=2.0,
+            zorder=MARKER_ZORDER,
+            label=f"{role} data ends (before CPA)",
+            gid=f"{role.replace(' ', '-')}-data-end",
+        )
+
+
+def encounter_figure(
+    outcome: EncounterOutcome, chart: Chart | None, ukc_m: float, frame: LocalFrame
+) -> Figure:
+    """The paper's result figure for one encounter, in the run's local frame, with latitude
+    and longitude on the axes and a scale bar (``chart_plot.geographic_axes``).
 
     The chart background (depth areas with a DRVAL1 colour bar, land, navigable water for the
     target's draught) when a chart covers the run; both tracks over the encounter with arrows
     for the direction of travel (own ship dark orange, target black dashed); both vessels at
     the trigger (hollow squares) and predicted at TCPA from the trigger (own ship red dot,
-    target black dot); and the target's projected arcs with red (restricted) and blue (clear)
-    ellipses at the trigger. The legend sits under the axes.
+    target black dot); an × where a track's data stops before CPA; and the target's projected
+    arcs with red (restricted) and blue (clear) ellipses at the trigger, half transparent so
+    that the tracks show through. The legend under the axes names both vessels with their
+    dimensions (``*``: a default, not reported); the title gives the times of the trigger and
+    of the predicted CPA.
     """
     s = outcome.summary
-    figure, ax = plt.subplots(figsize=(8.5, 8.8), layout="constrained")
+    figure, ax = plt.subplots(figsize=(8.5, 9.2), layout="constrained")
     if chart is not None:
         depths = draw_chart(ax, chart, s.target_draught_m, ukc_m)
         figure.colorbar(depths, ax=ax, label=DEPTH_LABEL, shrink=0.6, pad=0.02)
-    _draw_track(
-        ax, outcome.own_track, OWN_TRACK_COLOUR, "-", f"own ship {s.own_mmsi}", "own-direction"
+    own_label = _vessel_label(
+        "own ship",
+        s.own_name,
+        s.own_mmsi,
+        (s.own_length_m, s.own_breadth_m, s.own_draught_m, s.own_dimensions_defaulted),
     )
-    _draw_track(
-        ax,
-        outcome.target_track,
-        TARGET_COLOUR,
-        "--",
-        f"target {s.target_mmsi}",
-        "target-direction",
+    target_label = _vessel_label(
+        "target",
+        s.target_name,
+        s.target_mmsi,
+        (s.target_length_m, s.target_breadth_m, s.target_draught_m, s.target_dimensions_defaulted),
     )
+    _draw_track(ax, outcome.own_track, OWN_TRACK_COLOUR, "-", own_label, "own-direction")
+    _draw_track(ax, outcome.target_track, TARGET_COLOUR, "--", target_label, "target-direction")
+    if not s.data_covers_cpa:
+        _mark_data_end(ax, outcome.own_track, OWN_TRACK_COLOUR, "own ship")
+        _mark_data_end(ax, outcome.target_track, TARGET_COLOUR, "target")
     draw_assessment(ax, outcome.assessment)
     own_at_trigger_m, target_at_trigger_m = trigger_positions_m(outcome)
     _draw_positions(
@@ -380,10 +429,11 @@ def encounter_figure(outcome: EncounterOutcome, chart: Chart | None, ukc_m: floa
         ax, "target", target_at_trigger_m, outcome.target_at_tcpa_m, TARGET_COLOUR, TARGET_COLOUR
     )
     _zoom_to_encounter(ax, outcome)
-    ax.set_xlabel("east (m)")
-    ax.set_ylabel("north (m)")
+    geographic_axes(ax, frame)
     _legend_below(figure, ax)
-    ax.set_title(f"{s.encounter_id}\n{_verdict(outcome)}", fontsize="medium")
+    at_cpa = s.trigger_utc + pd.Timedelta(seconds=s.tcpa_s)
+    times = f"trigger {s.trigger_utc:%Y-%m-%d %H:%M:%S} UTC, CPA predicted at {at_cpa:%H:%M:%S}"
+    ax.set_title(f"{s.encounter_id}  ({times})\n{_verdict(outcome)}", fontsize="medium")
     return figure
 
 
@@ -438,10 +488,10 @@ def format_index(result: ReplayResult, plots: bool) -> str:
 
 
 def draw_encounter(
-    outcome: EncounterOutcome, target: Path, chart: Chart | None, ukc_m: float
+    outcome: EncounterOutcome, target: Path, chart: Chart | None, ukc_m: float, frame: LocalFrame
 ) -> Path:
     """One encounter's figure, saved to ``target``."""
-    figure = encounter_figure(outcome, chart, ukc_m)
+    figure = encounter_figure(outcome, chart, ukc_m, frame)
     try:
         save_figure(target, figure, dpi=120)
     finally:
@@ -451,13 +501,19 @@ def draw_encounter(
 
 FigureJobs = Sequence[tuple[EncounterOutcome, Path]]
 # Draws the figures of ``FigureJobs`` (chart, UKC), advancing the progress sink once each.
-Drawer = Callable[[FigureJobs, "Chart | None", float, "ProgressSink"], None]
+Drawer = Callable[[FigureJobs, "Chart | None", float, "LocalFrame", "ProgressSink"], None]
 
 
-def draw_here(jobs: FigureJobs, chart: Chart | None, ukc_m: float, progress: ProgressSink) -> None:
+def draw_here(
+    jobs: FigureJobs,
+    chart: Chart | None,
+    ukc_m: float,
+    frame: LocalFrame,
+    progress: ProgressSink,
+) -> None:
     """The figures drawn one after the other in this process."""
     for outcome, target in jobs:
-        draw_encounter(outcome, target, chart, ukc_m)
+        draw_encounter(outcome, target, chart, ukc_m, frame)
         progress.advance()
 
 
@@ -498,7 +554,7 @@ def _write_replay_files(
         else:
             progress.advance()
     if figures:
-        drawer(figures, chart, result.params.manoeuvrability.ukc_m, progress)
+        drawer(figures, chart, result.params.manoeuvrability.ukc_m, result.frame, progress)
     encounters_csv = out_dir / ENCOUNTERS_NAME
     encounters_table = _lowercase_booleans(encounters_frame(result.encounters))
     write_csv(encounters_csv, encounters_table)
