@@ -20,7 +20,7 @@ from .chart import CellInfo, Chart, load_chart
 from .errors import OutputError, ParameterError
 from .progress import progress_bar, progress_enabled
 from .report.atomic import atomic_path, save_figure
-from .report.chart_plot import draw_chart
+from .report.chart_plot import draw_chart, geographic_axes
 
 DEFAULT_REPORTS_DIR = Path("reports")
 GEOPACKAGE_LAYERS = ("depth_areas", "coverage", "land", "navigable_water")
@@ -217,8 +217,7 @@ def summarise_chart(
     try:
         depths = draw_chart(ax, chart, draught_m, ukc_m, coverage=True)
         figure.colorbar(depths, ax=ax, label="DRVAL1, shallowest depth (m)", shrink=0.7)
-        ax.set_xlabel("east (m)")
-        ax.set_ylabel("north (m)")
+        geographic_axes(ax, chart.frame)
         ax.set_title(
             f"{Path(paths[0]).name}: navigable water for draught {draught_m:g} m "
             f"+ UKC {ukc_m:g} m ({area_km2:.3f} km²)",

@@ -151,3 +151,28 @@ def test_the_chart_plot_outlines_the_coverage(tmp_path: Path) -> None:
         assert "coverage" not in {c.get_gid() for c in ax.collections}
     finally:
         plt.close(figure)
+
+
+@pytest.mark.parametrize("draught_m", [2.0, 5.0])
+def test_the_depths_are_banded_around_the_draught(draught_m: float) -> None:
+    """With a draught, each depth area's colour is its band's: warm where it is shallower
+    than the draught, pale blue where it is deeper, with a band edge at the draught."""
+    from matplotlib.colors import BoundaryNorm, to_hex
+
+    from colregs9_cli.chart import load_chart
+    from colregs9_cli.report.chart_plot import DEEP_COLOURS, SHALLOW_COLOURS, draw_chart
+
+    chart = load_chart([ENC])
+    figure, ax = plt.subplots()
+    try:
+        depths = draw_chart(ax, chart, draught_m)
+        assert isinstance(depths.norm, BoundaryNorm)
+        assert draught_m in list(depths.norm.boundaries)
+        colours = [to_hex(c) for c in depths.to_rgba(depths.get_array())]
+        values = np.asarray(depths.get_array())
+        shallow = values < draught_m
+        assert shallow.any() and (~shallow).any()
+        assert {c for c, s in zip(colours, shallow, strict=True) if s} <= set(SHALLOW_COLOURS)
+        assert {c for c, s in zip(colours, shallow, strict=True) if not s} <= set(DEEP_COLOURS)
+    finally:
+        plt.close(figure)

@@ -47,6 +47,8 @@ def test_figure_plots_each_class_at_its_lengths_and_rates() -> None:
             np.testing.assert_allclose(np.asarray(scatters[vessel_type]), expected)
         markers = {c.get_label(): c.get_paths()[0].vertices.shape[0] for c in ax.collections}
         assert markers["tanker"] != markers["coastguard"]  # square vs triangle, as in the paper
+        colours = [tuple(c.get_facecolor()[0]) for c in ax.collections]
+        assert len(set(colours)) == len(colours)  # no two classes share a colour
         levels = sorted(line.get_ydata()[0] for line in ax.get_lines())
         assert levels == [table["rate_of_swing_deg_per_m"].min(), 0.2]
         figure.canvas.draw()

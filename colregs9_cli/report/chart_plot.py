@@ -20,7 +20,7 @@ import shapely
 from matplotlib import colormaps
 from matplotlib.axes import Axes
 from matplotlib.collections import PatchCollection
-from matplotlib.colors import ListedColormap
+from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.patches import PathPatch
 from matplotlib.path import Path as MplPath
 from matplotlib.ticker import FuncFormatter, MaxNLocator
@@ -83,6 +83,27 @@ def _patches(geometries: Iterable[Any]) -> tuple[list[PathPatch], list[int]]:
     return patches, kept
 
 
+# Bands shallower than the draught (+ UKC) in warm colours, deeper ones in pale blues, so that
+# the water that matters stands out and the blue (clear) ellipses stay visible on it.
+SHALLOW_COLOURS = ("#d6604d", "#f4a582", "#fddbc7")
+DEEP_COLOURS = ("#f2f7fc", "#deebf7", "#c6dbef", "#a8cce4")
+# Band edges, as multiples of the draught + UKC, from drying to deep.
+BAND_MULTIPLES = (0.0, 0.5, 1.0, 1.5, 2.0, 4.0)
+
+
+def depth_bands(need_m: float, drval1_m: np.ndarray) -> tuple[list[float], list[str]]:
+    """Band edges (m) and colours for depth areas around ``need_m`` (draught + UKC): drying,
+    below half of it, below it, then up to 1.5, 2 and 4 times it, and deeper."""
+    finite = drval1_m[np.isfinite(drval1_m)]
+    low = min(float(finite.min()) if finite.size else 0.0, 0.0) - 1.0
+    high = max(float(finite.max()) if finite.size else 0.0, 4.0 * need_m) + 1.0
+    edges = [low, *(m * need_m for m in BAND_MULTIPLES), high]
+    colours = [*SHALLOW_COLOURS, *DEEP_COLOURS]
+    if need_m <= 0.0:  # no draught: only drying and not drying
+        return [low, 0.0, high], [SHALLOW_COLOURS[0], DEEP_COLOURS[0]]
+    return edges, colours
+
+
 def draw_chart(
     ax: Axes,
     chart: Chart,
@@ -91,13 +112,25 @@ def draw_chart(
     coverage: bool = False,
 ) -> Any:
     """Depth areas shaded by DRVAL1, land, and (with a draught) the navigable water outlined;
-    with ``coverage``, the chart's edge (its coverage) dashed.
+    with ``coverage``, the chart's edge (its coverage) dashed. With a draught the shading is
+    in discrete bands around it (``depth_bands``), else continuous.
 
     Returns the depth-area collection (a ScalarMappable, for a colour bar).
     """
     patches, kept = _patches(chart.depth_areas)
-    depths = PatchCollection(patches, cmap=DEPTH_CMAP, edgecolor="none", zorder=0)
-    depths.set_array(np.asarray(chart.drval1_m, dtype=float)[kept])
+    drval1 = np.asarray(chart.drval1_m, dtype=float)[kept]
+    if draught_m is None:
+        depths = PatchCollection(patches, cmap=DEPTH_CMAP, edgecolor="none", zorder=0)
+    else:
+        bands, colours = depth_bands(draught_m + ukc_m, drval1)
+        depths = PatchCollection(
+            patches,
+            cmap=ListedColormap(colours, name="depth-bands"),
+            norm=BoundaryNorm(bands, len(colours)),
+            edgecolor="none",
+            zorder=0,
+        )
+    depths.set_array(drval1)
     depths.set_gid("depth-areas")
     ax.add_collection(depths)
     land_patches, _ = _patches([chart.land])

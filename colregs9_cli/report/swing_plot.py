@@ -10,16 +10,17 @@ import matplotlib.pyplot as plt
 import pandas as pd
 from matplotlib.figure import Figure
 
-# The paper's pgfplots classes: squares for the first four, triangles for the rest.
+# The paper's pgfplots classes: squares for the first four, triangles for the rest. Each class
+# has a colour of its own (the paper repeats four), so that no two classes look alike.
 CLASS_STYLES: dict[str, tuple[str, str]] = {
     "tanker": ("s", "tab:blue"),
     "fishing": ("s", "tab:red"),
     "bulk carrier": ("s", "tab:orange"),
     "supply": ("s", "black"),
-    "coastguard": ("^", "tab:blue"),
-    "container": ("^", "tab:red"),
-    "cruiseship": ("^", "tab:orange"),
-    "vehicle carrier": ("^", "black"),
+    "coastguard": ("^", "tab:cyan"),
+    "container": ("^", "tab:pink"),
+    "cruiseship": ("^", "tab:olive"),
+    "vehicle carrier": ("^", "tab:brown"),
 }
 OTHER_STYLE = ("D", "0.5")
 
