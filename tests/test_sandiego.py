@@ -85,8 +85,10 @@ def test_report_geopackage_opens_with_every_layer(sandiego) -> None:
     import shapely
 
     path = sandiego.out_dir / "report.gpkg"
-    layers = {str(name) for name, _ in pyogrio.list_layers(path)}
+    layers = {str(name) for name, kind in pyogrio.list_layers(path) if kind}
     assert layers == {"encounters", "tracks", "cpa", "domains", "navigable_water"}
+    # the QGIS styles, an attribute table beside them
+    assert {str(name) for name, kind in pyogrio.list_layers(path) if not kind} == {"layer_styles"}
     for layer in layers:
         info = pyogrio.read_info(path, layer=layer)
         assert info["crs"] == "EPSG:4326" and info["features"] > 0, layer
@@ -104,3 +106,36 @@ def test_report_geopackage_opens_with_every_layer(sandiego) -> None:
     )
     domains = pyogrio.read_info(path, layer="domains")
     assert {"restricted", "covered", "arc", "step"} <= set(domains["fields"])
+
+
+def test_report_geopackage_domains_are_typed_and_every_layer_is_styled(sandiego) -> None:
+    import sqlite3
+    import xml.etree.ElementTree as ET
+
+    import pyogrio
+
+    path = sandiego.out_dir / "report.gpkg"
+    meta, _, _, fields = pyogrio.raw.read(path, layer="domains")
+    columns = dict(zip(meta["fields"], fields, strict=True))
+    dtypes = dict(zip(meta["fields"], meta["dtypes"], strict=True))
+    assert dtypes["restricted"] == dtypes["covered"] == "bool"
+    state = columns["state"]
+    assert set(state) <= {"restricted", "clear", "unknown"}
+    assert ((state == "restricted") == (columns["restricted"] & columns["covered"])).all()
+    assert ((state == "unknown") == ~columns["covered"]).all()
+    with sqlite3.connect(path) as db:
+        styles = db.execute(
+            "SELECT f_table_name, f_geometry_column, styleQML, useAsDefault FROM layer_styles"
+        ).fetchall()
+    layers = {str(name) for name, kind in pyogrio.list_layers(path) if kind}
+    assert {name for name, *_ in styles} == layers
+    for name, geometry_column, qml, default in styles:
+        assert default == 1 and geometry_column == "geom"
+        renderer = ET.fromstring(qml.split("'SYSTEM'>", 1)[1]).find("renderer-v2")
+        attribute = renderer.get("attr")
+        if attribute is None:
+            continue
+        # every value the layer holds has a category, so nothing is drawn unstyled
+        _, _, _, values = pyogrio.raw.read(path, layer=name, columns=[attribute])
+        categories = {c.get("value") for c in renderer.iter("category")}
+        assert set(map(str, values[0])) <= categories, name

@@ -6,10 +6,12 @@ Layers (each only when it has features):
   encounter row, with every ``encounters.csv`` column and ``vessel`` (own or target);
 - ``tracks``: each vessel's track over the encounter, a line per vessel and encounter;
 - ``cpa``: each vessel's position predicted at TCPA from the trigger;
-- ``domains``: the target's ship-domain ellipses at the trigger, with ``restricted``,
-  ``covered``, ``arc`` and ``step``;
+- ``domains``: the target's ship-domain ellipses at the trigger, with ``restricted`` and
+  ``covered`` (booleans), ``state`` (restricted, clear or unknown), ``arc`` and ``step``;
 - ``navigable_water``: the water deep enough for each target draught used, where a chart was
   given.
+
+Each layer carries a default QGIS style in the ``layer_styles`` table (``qgis_styles.py``).
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from ..chart import Chart
 from ..geo import LocalFrame
 from ..replay_results import ReplayResult
 from .atomic import atomic_path
+from .qgis_styles import add_layer_styles
 
 GEOPACKAGE_NAME = "report.gpkg"
 
@@ -42,13 +45,16 @@ def _to_wgs84(frame: LocalFrame, geometries: Any) -> np.ndarray:
 
 
 def _fields(table: pd.DataFrame) -> tuple[list[np.ndarray], list[str]]:
-    """Columns as GDAL fields: numbers as float or int, everything else as text."""
+    """Columns as GDAL fields: booleans as booleans, numbers as float, everything else as
+    text."""
     values: list[np.ndarray] = []
     names: list[str] = []
     for name in table.columns:
         column = table[name]
         numeric = pd.api.types.is_numeric_dtype(column) and not pd.api.types.is_bool_dtype(column)
-        if numeric:
+        if pd.api.types.is_bool_dtype(column) and not column.isna().any():
+            values.append(column.to_numpy(dtype=bool))
+        elif numeric:
             values.append(column.to_numpy(dtype=float, na_value=np.nan))
         else:
             values.append(
@@ -119,6 +125,11 @@ def write_replay_geopackage(
                     "step": assessment.step,
                     "restricted": assessment.restricted & assessment.covered,
                     "covered": assessment.covered,
+                    "state": np.where(
+                        ~assessment.covered,
+                        "unknown",
+                        np.where(assessment.restricted, "restricted", "clear"),
+                    ).astype(object),
                     "verdict": assessment.restriction.value,
                 }
             )
@@ -152,6 +163,7 @@ def write_replay_geopackage(
                 append=written > 0,
             )
             written += 1
+        add_layer_styles(tmp, [name for name, (wkb, _) in layers.items() if len(wkb)])
     return path
 
 
