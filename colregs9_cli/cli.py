@@ -14,6 +14,9 @@ from . import __version__
 from .errors import Colregs9Error
 from .quick_exit import run_and_exit
 
+# --quiet means the same everywhere: no progress on stderr; results and errors still print.
+QUIET_HELP = "No progress bars on stderr (also off when stderr is not a terminal)."
+
 app = typer.Typer(
     name="colregs9",
     help="COLREGs rule 9 (narrow channels) audits of historical AIS.",
@@ -181,7 +184,7 @@ def replay_command(
             "directory); on a multi-machine cluster, a directory every worker mounts.",
         ),
     ] = None,
-    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """Replay AIS pair by pair through COLREGs rules 13–15 and the rule 9 automaton.
 
@@ -240,7 +243,7 @@ def simulate_command(
             help="Output CSV. Default: reports/simulate-<scenario name>.csv.",
         ),
     ] = None,
-    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """Simulate a scenario into synthetic AIS in the DMA 26-column CSV layout.
 
@@ -310,7 +313,7 @@ def stats_command(
             help="Replace an --out directory that holds something other than a colregs9 report.",
         ),
     ] = False,
-    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bar.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """Vessel dimension statistics (length, breadth, draught), like the paper's table.
 
@@ -398,7 +401,7 @@ def chart_command(
             "(recorded in run.json).",
         ),
     ] = False,
-    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """Summarise charts: layers, depth range, extent; with --draught, the navigable water.
 
@@ -447,7 +450,7 @@ def demo_command(
             help="Query TOML with the paper's parameters. Default: the package's greenhopper.toml.",
         ),
     ] = None,
-    quiet: Annotated[bool, typer.Option("--quiet", help="No progress bars.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """The paper's Greenhopper case study: simulate and replay both scenarios, print the verdicts.
 
