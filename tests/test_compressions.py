@@ -64,3 +64,48 @@ def test_a_truncated_file_is_one_clear_error(tmp_path: Path, suffix: str) -> Non
     path.write_bytes(whole[: len(whole) // 2])
     with pytest.raises(InputFileError, match=rf"{path.name}: truncated or corrupt"):
         load_ais([path])
+
+
+def _zip_with(path: Path, flag_bits: int = 0, method: int | None = None) -> Path:
+    """A zip of the DMA fixture, its entry marked encrypted or with another method."""
+    import struct
+    import zipfile
+
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.write(DMA26, "aisdk.csv")
+    data = bytearray(path.read_bytes())
+    for signature, flags_at, method_at in ((b"PK\x03\x04", 6, 8), (b"PK\x01\x02", 8, 10)):
+        at = data.index(signature)
+        if flag_bits:
+            flags = struct.unpack_from("<H", data, at + flags_at)[0] | flag_bits
+            struct.pack_into("<H", data, at + flags_at, flags)
+        if method is not None:
+            struct.pack_into("<H", data, at + method_at, method)
+    path.write_bytes(bytes(data))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("flag_bits", "method", "message"),
+    [
+        (0x1, None, "aisdk.csv is encrypted in the zip"),
+        (0, 99, "compressed with zip method 99"),  # AES, as 7-Zip writes it
+        (0, 9, "compressed with zip method 9"),  # deflate64
+    ],
+)
+def test_a_zip_that_cannot_be_read_is_one_clear_error(
+    tmp_path: Path, flag_bits: int, method: int | None, message: str
+) -> None:
+    path = _zip_with(tmp_path / "aisdk.zip", flag_bits, method)
+    with pytest.raises(InputFileError, match=message):
+        load_ais([path])
+
+
+def test_a_tar_archive_is_refused_clearly(tmp_path: Path) -> None:
+    import tarfile
+
+    path = tmp_path / "aisdk.tar.gz"
+    with tarfile.open(path, "w:gz") as archive:
+        archive.add(DMA26, "aisdk.csv")
+    with pytest.raises(InputFileError, match=r"a tar archive; extract it \(tar xf aisdk.tar.gz\)"):
+        load_ais([path])

@@ -106,6 +106,7 @@ def test_the_console_script_writes_everything_before_it_leaves(tmp_path: Path) -
         "dimension_histograms.png",
         "dimension_stats.csv",
         "dimension_stats.md",
+        "index.html",
         "run.json",
     ]
 

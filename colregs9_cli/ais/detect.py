@@ -70,6 +70,9 @@ DEFAULT_COLUMNS: dict[str, tuple[str, ...]] = {
     "marinecadastre": MARINECADASTRE_COLUMNS,
 }
 
+# A tar archive (POSIX ustar or GNU) names itself at byte 257 of its first header.
+_TAR_MAGIC_AT = 257
+_TAR_MAGIC = b"ustar"
 _DMA_TIME = re.compile(r"^\d{2}/\d{2}/\d{4} \d{2}:\d{2}:\d{2}$")
 _ISO_TIME = re.compile(r"^\d{4}-\d{2}-\d{2}[T ]\d{2}:\d{2}:\d{2}")
 _SHOWN_CHARS = 80
@@ -100,6 +103,11 @@ def detect_layout(source: Source, head: bytes) -> str:
     """The layout of ``source`` from the first bytes of its (decompressed) data."""
     if source.compression == "none" and head.startswith(PARQUET_MAGIC):
         return "parquet"
+    if head[_TAR_MAGIC_AT : _TAR_MAGIC_AT + len(_TAR_MAGIC)] == _TAR_MAGIC:
+        raise InputFileError(
+            f"{source.name}: a tar archive; extract it (tar xf {source.path.name}) and give "
+            "the AIS file inside"
+        )
     line = first_line(head)
     if not line:
         raise InputFileError(f"{source.name}: holds only blank lines; give a file with AIS data")
@@ -111,11 +119,15 @@ def detect_layout(source: Source, head: bytes) -> str:
         return "dma26" if {"a", "b", "c", "d"} <= names else "dma22"
     if {"mmsi", "basedatetime", "lat", "lon"} <= names:
         return "marinecadastre"
-    if _DMA_TIME.match(fields[0]) and len(fields) in (22, 26):
-        return "dma26" if len(fields) == 26 else "dma22"
-    if len(fields) == len(MARINECADASTRE_COLUMNS) and _ISO_TIME.match(fields[1]):
-        return "marinecadastre"
     shown = line if len(line) <= _SHOWN_CHARS else line[:_SHOWN_CHARS] + "..."
+    if _DMA_TIME.match(fields[0]) or any(_ISO_TIME.match(f) for f in fields[:3]):
+        # Data where a header should be (a file cut with split, say): the columns could be
+        # in any order, and MarineCadastre's own files put longitude first since 2025.
+        raise InputFileError(
+            f"{source.name}: no header line; the first line is data ({shown!r}). colregs9 "
+            "does not guess which column is which: put the header line back, or give "
+            f"--format ({', '.join(CSV_LAYOUTS)}) if the columns are in that layout's order"
+        )
     raise InputFileError(
         f"{source.name}: unknown AIS layout; the first line is {shown!r}. Accepted layouts: "
         f"{', '.join(LAYOUTS)}; give one with --format if the file is one of them"

@@ -88,18 +88,44 @@ def inspect_source(path: Path) -> Source:
     return Source(path, "none", None, size)
 
 
+# The compression methods Python's zipfile reads.
+_ZIP_METHODS = {
+    zipfile.ZIP_STORED: "stored",
+    zipfile.ZIP_DEFLATED: "deflate",
+    zipfile.ZIP_BZIP2: "bzip2",
+    zipfile.ZIP_LZMA: "lzma",
+}
+
+
 def _zip_member(path: Path) -> str:
     try:
         with zipfile.ZipFile(path) as archive:
-            names = [
-                info.filename
+            infos = {
+                info.filename: info
                 for info in archive.infolist()
                 if not info.is_dir() and not info.filename.startswith("__MACOSX/")
-            ]
+            }
     except (zipfile.BadZipFile, OSError, EOFError) as exc:
         raise InputFileError(
             f"{path}: truncated or corrupt zip ({exc}); download the file again"
         ) from None
+    member = _only_data_file(path, list(infos))
+    info = infos[member]
+    if info.flag_bits & 0x1:
+        raise InputFileError(
+            f"{path}: {member} is encrypted in the zip; unzip it with its password and give "
+            "the file itself"
+        )
+    if info.compress_type not in _ZIP_METHODS:
+        raise InputFileError(
+            f"{path}: {member} is compressed with zip method {info.compress_type}, which "
+            f"colregs9 cannot read ({', '.join(_ZIP_METHODS.values())} only); unzip it with "
+            "another tool and give the file itself"
+        )
+    return member
+
+
+def _only_data_file(path: Path, names: list[str]) -> str:
     csvs = [n for n in names if n.lower().endswith(".csv")]
     if len(csvs) == 1:
         return csvs[0]
