@@ -32,7 +32,9 @@ def _user_errors() -> Iterator[None]:
     try:
         yield
     except Colregs9Error as exc:
-        typer.echo(f"Error: {exc}", err=True)
+        # One line, whatever a file name or a value in the message holds.
+        message = str(exc).replace("\r", "\\r").replace("\n", "\\n")
+        typer.echo(f"Error: {message}", err=True)
         raise typer.Exit(exc.exit_code) from None
 
 

@@ -397,3 +397,13 @@ def test_per_and_by_enums_match_the_cli_choices() -> None:
     help_text = CliRunner().invoke(app, ["stats", "--help"]).output
     for value in (*Per, *GroupBy):
         assert value.value in help_text
+
+
+def test_an_error_about_a_file_with_a_newline_in_its_name_is_one_line(tmp_path: Path) -> None:
+    path = tmp_path / "new\nline.csv"
+    path.write_text("a\nb\n")
+    result = CliRunner().invoke(app, ["stats", str(path), "--quiet", "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    lines = result.output.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error: ")
+    assert "new\\nline.csv" in lines[0]
