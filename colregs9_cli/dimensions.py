@@ -30,6 +30,10 @@ STAT_COLUMNS: tuple[str, ...] = ("count", "mean", "median", "std", "min", "max")
 NO_SHIP_TYPE = "Unknown"
 
 
+# The group name of the overall rows in a grouped CSV: no ship type is written this way.
+ALL_GROUPS = "(all)"
+
+
 class Per(StrEnum):
     VESSEL = "vessel"
     MESSAGE = "message"
@@ -108,15 +112,15 @@ class StatsResult:
         return "vessels" if self.per is Per.VESSEL else "messages"
 
     def to_frame(self) -> pd.DataFrame:
-        """The CSV table: ``dimension`` then exactly ``STAT_COLUMNS`` (``ship_type`` first
-        when grouped)."""
-        tables = self.groups if self.by is not None else (self.overall,)
+        """The CSV table: ``dimension`` then exactly ``STAT_COLUMNS``. Grouped, ``ship_type``
+        comes first, and the overall rows come first as the group ``ALL_GROUPS``."""
+        tables = (self.overall, *self.groups) if self.by is not None else (self.overall,)
         records = []
         for table in tables:
             for row in table.rows:
                 record: dict[str, Any] = {}
                 if self.by is not None:
-                    record[self.by.value] = table.group
+                    record[self.by.value] = ALL_GROUPS if table is self.overall else table.group
                 record["dimension"] = row.dimension
                 record.update({name: getattr(row, name) for name in STAT_COLUMNS})
                 records.append(record)

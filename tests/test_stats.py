@@ -197,7 +197,13 @@ def test_by_ship_type_per_vessel() -> None:
         "min",
         "max",
     ]
-    assert len(frame) == 4 * 3
+    # the overall rows first, then each ship type's
+    assert len(frame) == (1 + 4) * 3
+    assert frame["ship_type"].iloc[:3].tolist() == ["(all)"] * 3
+    overall = frame[frame["ship_type"] == "(all)"].drop(columns="ship_type")
+    pd.testing.assert_frame_equal(
+        overall.reset_index(drop=True), dimension_stats(POSITIONS, DIMENSION_REPORTS).to_frame()
+    )
     assert frame.loc[frame["ship_type"] == "Cargo", "count"].tolist() == [2, 2, 2]
 
 

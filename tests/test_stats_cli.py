@@ -307,9 +307,12 @@ def test_by_ship_type(tmp_path: Path) -> None:
     overall = {row["dimension"]: row for row in manifest["table"]["rows"]}
     # Every vessel lands in exactly one ship type.
     assert sum(group["units"] for group in manifest["groups"]) == manifest["vessels"] == 998
+    everything = table[table["ship_type"] == "(all)"].set_index("dimension")
+    table = table[table["ship_type"] != "(all)"]
     for dimension in DIMENSIONS:
         part = table[table["dimension"] == dimension]
         assert part["count"].sum() == overall[dimension]["count"]
+        assert everything.loc[dimension, "count"] == overall[dimension]["count"]
         assert part["max"].max() == pytest.approx(overall[dimension]["max"])
     assert table["ship_type"].nunique() == len(manifest["groups"]) > 1
     markdown = (tmp_path / "dimension_stats.md").read_text()
@@ -407,3 +410,21 @@ def test_an_error_about_a_file_with_a_newline_in_its_name_is_one_line(tmp_path: 
     lines = result.output.splitlines()
     assert len(lines) == 1 and lines[0].startswith("Error: ")
     assert "new\\nline.csv" in lines[0]
+
+
+def test_histograms_by_ship_type_are_stacked_by_type(tmp_path: Path) -> None:
+    run = run_stats([MARINECADASTRE], per=Per.VESSEL, by=GroupBy.SHIP_TYPE, out_dir=tmp_path)
+    figure = histogram_figure(run.result, "all")
+    groups = {table.group: table for table in run.result.groups}
+    (legend,) = figure.legends
+    assert {text.get_text() for text in legend.get_texts()} <= set(groups)
+    for axis, dimension in zip(figure.axes, DIMENSIONS, strict=True):
+        bars = [p for p in axis.patches if isinstance(p, Rectangle)]
+        # every counted vessel once, in the colour of her type
+        assert sum(bar.get_height() for bar in bars) == run.result.overall.row(dimension).count
+        by_colour: dict[tuple[float, ...], float] = {}
+        for bar in bars:
+            colour = tuple(bar.get_facecolor())
+            by_colour[colour] = by_colour.get(colour, 0) + bar.get_height()
+        counts = sorted(g.row(dimension).count for g in groups.values() if g.row(dimension).count)
+        assert sorted(by_colour.values()) == counts

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from matplotlib import colormaps
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
@@ -34,6 +35,8 @@ DIMENSION_LABELS: dict[str, str] = {
     "draught_m": "Draught (m)",
 }
 HISTOGRAM_MAX_BINS = 40
+# Ship types stacked in the histograms: 40 colours before one repeats (DMA has 27 types).
+TYPE_COLOURS = [tuple(c) for name in ("tab20", "tab20b") for c in colormaps[name](np.arange(20))]
 
 
 def _number(value: float, decimals: int) -> str:
@@ -121,17 +124,33 @@ def format_markdown(result: StatsResult, query_name: str) -> str:
 
 
 def histogram_figure(result: StatsResult, query_name: str) -> Figure:
-    """Three histograms (length, breadth, draught) of the counted units' values."""
+    """Three histograms (length, breadth, draught) of the counted units' values, stacked by
+    ship type when the statistics are grouped by it."""
     # A bare Figure renders with Agg on save, without pyplot's backend machinery. Fixed
     # margins: a layout engine would double the time of drawing these three panels.
     figure = Figure(figsize=(13, 4))
     figure.subplots_adjust(left=0.05, right=0.99, bottom=0.13, top=0.82, wspace=0.22)
     axes = figure.subplots(1, 3)
     for axis, (dimension, label) in zip(axes, DIMENSION_LABELS.items(), strict=True):
-        values = result.samples[dimension].dropna().to_numpy(dtype=float)
+        samples = result.samples[["ship_type", dimension]].dropna(subset=[dimension])
+        values = samples[dimension].to_numpy(dtype=float)
         if values.size:
             bins = min(HISTOGRAM_MAX_BINS, len(np.histogram_bin_edges(values, bins="auto")) - 1)
-            axis.hist(values, bins=max(bins, 1), color="tab:blue", edgecolor="white")
+            edges = np.histogram_bin_edges(values, bins=max(bins, 1))
+            if result.by is None:
+                axis.hist(values, bins=edges, color="tab:blue", edgecolor="white")
+            else:
+                # Stacked by ship type: the bars' heights are the overall histogram's.
+                groups = sorted(samples.groupby(samples["ship_type"].fillna("Unknown")))
+                axis.hist(
+                    [group[dimension].to_numpy(dtype=float) for _, group in groups],
+                    bins=edges,
+                    stacked=True,
+                    color=[TYPE_COLOURS[i % len(TYPE_COLOURS)] for i in range(len(groups))],
+                    label=[str(name) for name, _ in groups],
+                    edgecolor="white",
+                    linewidth=0.3,
+                )
         else:
             axis.text(0.5, 0.5, "no values", ha="center", va="center", transform=axis.transAxes)
         # Few ticks: each costs about a millisecond to make and draw.
@@ -142,6 +161,9 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
         # A set height spares matplotlib its search for tick labels above the axes.
         axis.set_title(f"{label}: n = {values.size}", y=1.0)
     figure.suptitle(_title(result, query_name))
+    if result.by is not None and axes[0].get_legend_handles_labels()[0]:
+        figure.subplots_adjust(right=0.86)
+        figure.legend(*axes[0].get_legend_handles_labels(), loc="center right", fontsize="x-small")
     return figure
 
 
