@@ -391,6 +391,19 @@ def _polygon_from_file(query_path: Path, relative: Any) -> Polygon | MultiPolygo
     return _polygon_from_text(text, f"{polygon_path}")
 
 
+def _first_bad_coordinate(coordinates: Any) -> Any:
+    """The first value in nested coordinate lists that is not a finite number, else None."""
+    if isinstance(coordinates, list | tuple):
+        for item in coordinates:
+            bad = _first_bad_coordinate(item)
+            if bad is not None:
+                return bad
+        return None
+    if isinstance(coordinates, bool) or not isinstance(coordinates, int | float):
+        return coordinates
+    return None if math.isfinite(coordinates) else coordinates
+
+
 def _polygon_from_geojson(geojson: Any, where: str) -> Polygon | MultiPolygon:
     """A Polygon/MultiPolygon geometry, or a Feature/FeatureCollection of them (their union)."""
     if not isinstance(geojson, dict) or "type" not in geojson:
@@ -408,6 +421,12 @@ def _polygon_from_geojson(geojson: Any, where: str) -> Polygon | MultiPolygon:
         return _polygon_from_geojson(geojson.get("geometry"), where)
     if kind not in ("Polygon", "MultiPolygon"):
         raise QueryError(f"{where}: geometry type {kind!r}; give a Polygon or MultiPolygon")
+    bad = _first_bad_coordinate(geojson.get("coordinates"))
+    if bad is not None:
+        raise QueryError(
+            f"{where}: the coordinate {bad!r} is not a finite number; give longitude and "
+            "latitude in degrees"
+        )
     try:
         geometry = shape(geojson)
     except (ValueError, TypeError, AttributeError, IndexError, KeyError) as exc:

@@ -51,3 +51,20 @@ def test_vessel_defaults_replace_an_impossible_value() -> None:
     dims = vessel_dimensions({"length_m": 1e400, "breadth_m": 90.0, "draught_m": 5.0})
     assert dims.defaulted == ("length_m", "breadth_m")
     assert dims.draught_m == 5.0
+
+
+@pytest.mark.parametrize("mmsi", ["12345678901234567890", "1e30", "-99999999999999999999"])
+def test_an_mmsi_too_long_for_any_vessel_is_invalid_without_a_warning(
+    tmp_path: Path, mmsi: str
+) -> None:
+    import warnings
+
+    lines = DMA26.read_text(encoding="utf-8").splitlines()
+    lines[1] = lines[1].replace("257739000", mmsi)
+    path = tmp_path / "long_mmsi.csv"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        data = load_ais([path])
+    assert data.ledger.balanced
+    assert data.ledger.to_dict()["rejects_by_reason"].get("invalid_mmsi", 0) >= 1

@@ -164,3 +164,14 @@ def test_bad_polygons(tmp_path: Path) -> None:
         load_query(write(tmp_path, "[region]\npolygon = '{nope'\n"))
     with pytest.raises(InputFileError, match="no such file"):
         load_query(write(tmp_path, "[region]\npolygon_file = 'none.geojson'\n"))
+
+
+@pytest.mark.parametrize("value", ["NaN", "Infinity", '"10"'])
+def test_a_polygon_vertex_that_is_not_a_finite_number(tmp_path: Path, value: str) -> None:
+    import warnings
+
+    polygon = f'{{"type":"Polygon","coordinates":[[[10,57],[11,57],[{value},58],[10,57]]]}}'
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(QueryError, match="is not a finite number"):
+            load_query(write(tmp_path, f"[region]\npolygon = '{polygon}'\n"))

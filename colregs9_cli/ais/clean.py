@@ -288,6 +288,10 @@ class Fields:
         return len(self.mmsi)
 
 
+# Larger than any MMSI (nine digits); the row is then an invalid MMSI.
+_MMSI_LIMIT = 1e12
+
+
 def mmsi_column(values: pa.Array | pa.ChunkedArray) -> tuple[NDArray[np.int64], BoolArray]:
     """MMSIs as int64 (-1 where missing or not an integer), and where the text was not a number."""
     if pa.types.is_integer(values.type):
@@ -296,6 +300,8 @@ def mmsi_column(values: pa.Array | pa.ChunkedArray) -> tuple[NDArray[np.int64], 
     floats, bad = float_column(values)
     whole = np.isfinite(floats) & (np.floor(floats) == floats)
     bad = bad | (np.isfinite(floats) & ~whole)
+    # A number too long for any MMSI (20 digits would not even fit int64) is invalid, not cast.
+    whole &= np.abs(np.where(whole, floats, 0.0)) < _MMSI_LIMIT
     return np.where(whole, floats, -1).astype(np.int64), bad
 
 
