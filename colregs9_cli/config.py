@@ -15,7 +15,7 @@ import typing
 from pathlib import Path
 from typing import Any, TypeVar
 
-from .errors import InputFileError, QueryError
+from .errors import InputFileError, ParameterError, QueryError
 
 T = TypeVar("T")
 
@@ -48,7 +48,11 @@ def _accepts(annotation: Any, value: Any) -> bool:
     if annotation is int:
         return isinstance(value, int) and not isinstance(value, bool)
     if origin in (tuple, list, frozenset, set):
-        return isinstance(value, list | tuple)
+        if not isinstance(value, list | tuple):
+            return False
+        arguments = [a for a in typing.get_args(annotation) if a is not Ellipsis]
+        item = arguments[0] if len(arguments) == 1 else typing.Any
+        return all(_accepts(item, v) and _hashable(v) for v in value)
     if isinstance(annotation, type) and issubclass(annotation, dataclasses.Field):
         return True
     if isinstance(annotation, type):
@@ -56,6 +60,10 @@ def _accepts(annotation: Any, value: Any) -> bool:
             return value in {m.value for m in annotation}  # type: ignore[attr-defined]
         return isinstance(value, annotation)
     return True
+
+
+def _hashable(value: Any) -> bool:
+    return not isinstance(value, list | dict)
 
 
 def _convert(annotation: Any, value: Any) -> Any:
@@ -100,4 +108,11 @@ def dataclass_from_table(cls: type[T], table: dict[str, Any], where: str) -> T:
                 f"{getattr(annotation, '__name__', annotation)}"
             )
         values[name] = _convert(annotation, value)
-    return cls(**values)
+    try:
+        return cls(**values)
+    except (ParameterError, QueryError) as exc:
+        # The dataclass checks ranges without knowing the file: name it here.
+        message = str(exc)
+        file_part = where.split(" [", 1)[0]
+        located = f"{file_part} {message}" if message.startswith("[") else f"{where}: {message}"
+        raise type(exc)(located) from None

@@ -67,6 +67,11 @@ _NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
 _MMSI_MIN, _MMSI_MAX = 100_000_000, 999_999_999
 
 
+def is_report_name(name: Any) -> bool:
+    """True for a name that may name a report directory or file: no path, no control bytes."""
+    return isinstance(name, str) and bool(_NAME_PATTERN.fullmatch(name))
+
+
 def _is_number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
@@ -290,7 +295,7 @@ def load_query(path: Path) -> Query:
             f"{', '.join(sorted(TOP_LEVEL_KEYS))}"
         )
     name = document.get("name", path.stem)
-    if not isinstance(name, str) or not _NAME_PATTERN.match(name):
+    if not is_report_name(name):
         raise QueryError(
             f"{path}: name = {name!r}; use letters, digits, '_', '-' and '.' "
             "(it names the report directory)"
@@ -373,6 +378,8 @@ def _polygon_from_text(text: Any, where: str) -> Polygon | MultiPolygon:
         geojson = json.loads(text)
     except json.JSONDecodeError as exc:
         raise QueryError(f"{where}: not valid JSON ({exc})") from None
+    except RecursionError:
+        raise QueryError(f"{where}: the GeoJSON is nested too deeply to be a polygon") from None
     return _polygon_from_geojson(geojson, where)
 
 
@@ -410,7 +417,12 @@ def _polygon_from_geojson(geojson: Any, where: str) -> Polygon | MultiPolygon:
         raise QueryError(f"{where}: expected a GeoJSON object with a 'type'")
     kind = geojson["type"]
     if kind == "FeatureCollection":
-        parts = [_polygon_from_geojson(feature, where) for feature in geojson.get("features") or []]
+        features = geojson.get("features")
+        if not isinstance(features, list):
+            raise QueryError(
+                f"{where}: the FeatureCollection's features = {features!r}; give a list"
+            )
+        parts = [_polygon_from_geojson(feature, where) for feature in features]
         if not parts:
             raise QueryError(f"{where}: the FeatureCollection has no features")
         merged: BaseGeometry = shapely.union_all(parts)
@@ -448,9 +460,13 @@ def _utc(value: Any, where: str) -> datetime:
         value = datetime.combine(value, time(0, 0))
     if not isinstance(value, datetime):
         raise QueryError(f"{where} = {value!r} is not a time; write e.g. 2024-09-09T12:00:00Z")
-    if value.tzinfo is None:
-        return value.replace(tzinfo=UTC)
-    return value.astimezone(UTC)
+    try:
+        return value.replace(tzinfo=UTC) if value.tzinfo is None else value.astimezone(UTC)
+    except OverflowError:
+        raise QueryError(
+            f"{where} = {value.isoformat()} is beyond the range of times; give a time between "
+            "1980 and 2099"
+        ) from None
 
 
 def _time_window(path: Path, table: dict[str, Any]) -> TimeWindow:
@@ -475,8 +491,8 @@ def _vessel_filter(path: Path, table: dict[str, Any]) -> VesselFilter:
     for key in ("mmsi_include", "mmsi_exclude"):
         if key in table:
             items = table[key]
-            if not isinstance(items, list):
-                raise QueryError(f"{where} {key} = {items!r}; give a list of MMSIs")
+            if not isinstance(items, list) or any(isinstance(v, list | dict) for v in items):
+                raise QueryError(f"{where} {key} = {items!r}; give a flat list of MMSIs")
             values[key] = frozenset(items)
     for key in ("length_min_m", "length_max_m"):
         if key in table:

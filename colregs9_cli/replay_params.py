@@ -26,6 +26,11 @@ class CourseSource(StrEnum):
     HEADING = "heading"
 
 
+# The most steps one vessel may have in a slab's window: 13 float columns of 8 bytes make a
+# gigabyte per vessel at 1e7.
+MAX_STEPS_PER_SLAB = 1e7
+
+
 @dataclass(frozen=True)
 class ReplayParams:
     """The ``[replay]`` table.
@@ -110,6 +115,16 @@ class ReplayParams:
             raise ParameterError(
                 f"[replay] max_gap_s = {self.max_gap_s} is shorter than step_s = {self.step_s}; "
                 "give a gap of at least one step"
+            )
+        window_steps = (
+            self.slab_s + 2.0 * self.tcpa_act_s + 60.0 + 4.0 * self.max_gap_s
+        ) / self.step_s
+        if window_steps > MAX_STEPS_PER_SLAB:
+            raise ParameterError(
+                f"[replay] step_s = {self.step_s:g} s: a slab of {self.slab_s:g} s would hold "
+                f"{window_steps:.3g} steps for each vessel, more than memory allows "
+                f"({MAX_STEPS_PER_SLAB:.0e}); give a longer step_s (AIS reports come every 2 s "
+                "at the most) or a shorter slab_s"
             )
         if self.course_change_deg > 180.0:
             raise ParameterError(

@@ -27,6 +27,7 @@ from .chart import Chart, load_chart
 from .config import read_toml
 from .errors import QueryError
 from .geo import LocalFrame
+from .query import is_report_name
 
 _SCENARIO_KEYS = {
     "name": str,
@@ -230,6 +231,10 @@ def _vessel(table: Any, index: int, source: Path) -> VesselSpec:
     )
 
 
+# The most integration steps a scenario may take (a vessel's arrays hold one row each).
+MAX_SCENARIO_STEPS = 1e7
+
+
 def load_scenario(path: Path) -> Scenario:
     """Parse and validate a scenario TOML file (without the chart check)."""
     table = read_toml(path)
@@ -240,9 +245,25 @@ def load_scenario(path: Path) -> Scenario:
         for key, kind in _SCENARIO_KEYS.items()
         if key in table
     }
+    if not is_report_name(values["name"]):
+        raise QueryError(
+            f"{where}: name = {values['name']!r}; use letters, digits, '_', '-' and '.' "
+            "(it names the output files)"
+        )
     for key in ("duration_s", "step_s", "ais_interval_s"):
         _positive(values[key], where, key)
+    steps = values["duration_s"] / values["step_s"]
+    if steps > MAX_SCENARIO_STEPS:
+        raise QueryError(
+            f"{where}: duration_s / step_s = {steps:.3g} integration steps, more than "
+            f"{MAX_SCENARIO_STEPS:.0e}; give a shorter duration_s or a longer step_s"
+        )
     ratio = values["ais_interval_s"] / values["step_s"]
+    if ratio < 1.0 - 1e-9:
+        raise QueryError(
+            f"{where}: ais_interval_s = {values['ais_interval_s']} is shorter than step_s = "
+            f"{values['step_s']}; reports are emitted at integration steps"
+        )
     if abs(ratio - round(ratio)) > 1e-9:
         raise QueryError(
             f"{where}: ais_interval_s = {values['ais_interval_s']} is not a multiple of "
