@@ -472,6 +472,26 @@ def _dsid_detail(columns: Mapping[str, Any], detail: dict[str, float]) -> None:
 
 
 def _to_wgs84(geometries: NDArray[np.object_], crs: str | None, path: Path) -> Any:
+    """The geometries in WGS84 longitude/latitude; coordinates off the Earth are an error
+    naming the file (a projected chart without its CRS, say)."""
+    return _on_earth(_transformed(geometries, crs, path), path)
+
+
+def _on_earth(geometries: NDArray[np.object_], path: Path) -> NDArray[np.object_]:
+    present = geometries[~shapely.is_empty(geometries)] if len(geometries) else geometries
+    if len(present) == 0:
+        return geometries
+    lon_min, lat_min, lon_max, lat_max = shapely.total_bounds(present)
+    if not (-90.0 <= lat_min <= lat_max <= 90.0 and -180.0 <= lon_min <= lon_max <= 180.0):
+        raise ChartError(
+            f"{path}: coordinates off the Earth (longitude {lon_min:g} to {lon_max:g}, latitude "
+            f"{lat_min:g} to {lat_max:g}); give the chart in WGS84 longitude/latitude, or with "
+            "its coordinate reference system"
+        )
+    return geometries
+
+
+def _transformed(geometries: NDArray[np.object_], crs: str | None, path: Path) -> Any:
     if crs is None:
         return geometries
     try:
