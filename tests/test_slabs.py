@@ -23,7 +23,7 @@ from colregs9_cli.tracks import (
 
 from fixture_files import NMEA, SANDIEGO_AIS, SANDIEGO_ENC
 
-ONE_SLAB = {"replay": {"slab_s": 1e7}}
+ONE_SLAB = {"replay": {"slab_s": 86400.0}}  # every fixture lies within one day
 
 
 def _replay(paths, charts=(), slab_s: float | None = None):
