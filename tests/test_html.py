@@ -13,7 +13,7 @@ import pytest
 from colregs9_cli.replay import run_replay
 from colregs9_cli.stats import run_stats
 
-from fixture_files import DMA26, SANDIEGO_AIS, SANDIEGO_ENC
+from fixture_files import DMA26, NMEA
 
 CHROMIUM_FLAGS = (
     "--headless",
@@ -45,9 +45,9 @@ def rendered(page: Path, tmp_path: Path, query: str = "") -> str:
 
 
 @pytest.fixture(scope="module")
-def sandiego_report(tmp_path_factory: pytest.TempPathFactory):
+def national_report(tmp_path_factory: pytest.TempPathFactory):
     out = tmp_path_factory.mktemp("html") / "report"
-    result = run_replay([SANDIEGO_AIS], [SANDIEGO_ENC], out_dir=out, plots=True)
+    result = run_replay([NMEA], out_dir=out, plots=True)
     return result, out
 
 
@@ -57,24 +57,24 @@ def _rows(dom: str) -> list[str]:
     return re.findall(r"<tr( class=\"hidden\")?>", body)
 
 
-def test_replay_page_shows_every_encounter_and_figure(sandiego_report, tmp_path) -> None:
-    result, out = sandiego_report
+def test_replay_page_shows_every_encounter_and_figure(national_report, tmp_path) -> None:
+    result, out = national_report
     page = out / "index.html"
     # Nothing is fetched from the network (the SVG's namespace names are not fetched).
     assert not re.search(r'(src|href|url)\s*[=(]\s*["\']?https?:', page.read_text())
     dom = rendered(page, tmp_path)
-    assert len(_rows(dom)) == len(result.encounters) == 38
+    assert len(_rows(dom)) == len(result.encounters) == 24
     # Every figure loaded: the page replaces one that does not with a "missing" note.
-    assert dom.count('class="figure"') == 38
+    assert dom.count('class="figure"') == 24
     assert 'class="missing"' not in dom
-    assert dom.count('<section class="encounter"') == 38
+    assert dom.count('<section class="encounter"') == 24
     assert "<svg" in dom  # the overview map, drawn inline
     for outcome in result.encounters:
         assert f'href="#enc-{outcome.summary.encounter_id}"' in dom
 
 
-def test_replay_page_filters_and_sorts_in_the_browser(sandiego_report, tmp_path) -> None:
-    result, out = sandiego_report
+def test_replay_page_filters_and_sorts_in_the_browser(national_report, tmp_path) -> None:
+    result, out = national_report
     head_on = sum(o.summary.situation.value == "head-on" for o in result.encounters)
     assert 0 < head_on < len(result.encounters)
     dom = rendered(out / "index.html", tmp_path, "?q=head-on&sort=9")
@@ -85,8 +85,8 @@ def test_replay_page_filters_and_sorts_in_the_browser(sandiego_report, tmp_path)
     assert cpas == sorted(cpas)
 
 
-def test_a_missing_figure_is_marked_not_broken(sandiego_report, tmp_path) -> None:
-    _, out = sandiego_report
+def test_a_missing_figure_is_marked_not_broken(national_report, tmp_path) -> None:
+    _, out = national_report
     copy = tmp_path / "copy"
     shutil.copytree(out, copy)
     first = sorted((copy / "encounters").glob("*.png"))[0]

@@ -145,7 +145,7 @@ def _reports(draw) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)[list(REPORT_COLUMNS)]
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(reports=_reports(), slab_s=st.sampled_from([5.0, 20.0, 60.0, 300.0, 1000.0]))
 def test_segmentation_in_slabs_decides_every_report_as_in_one_go(reports, slab_s) -> None:
     params = ReplayParams()
