@@ -62,7 +62,8 @@ def replay_command(
         list[Path],
         typer.Argument(
             metavar="AIS...",
-            help="AIS files: DMA CSV (22/26 columns), MarineCadastre CSV or raw NMEA (.gz ok).",
+            help="AIS files: DMA CSV (22/26 columns), MarineCadastre CSV or raw NMEA (.gz ok); "
+            "or dataset directories made by colregs9 ingest.",
         ),
     ],
     chart: Annotated[
@@ -269,7 +270,7 @@ def stats_command(
         typer.Argument(
             metavar="AIS...",
             help="AIS files: DMA CSV (22/26 columns, .gz/.zip ok), MarineCadastre CSV, raw "
-            "NMEA or canonical Parquet.",
+            "NMEA or canonical Parquet; or dataset directories made by colregs9 ingest.",
         ),
     ],
     query: Annotated[
@@ -341,6 +342,60 @@ def stats_command(
     typer.echo(result.text, nl=False)
     if not quiet:
         typer.echo(f"Reports in {result.out_dir}", err=True)
+
+
+@app.command("ingest")
+def ingest_command(
+    ais: Annotated[
+        list[Path],
+        typer.Argument(
+            metavar="AIS...",
+            help="AIS files: DMA CSV (22/26 columns, .gz/.zip ok), MarineCadastre CSV, raw "
+            "NMEA or canonical Parquet.",
+        ),
+    ],
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            metavar="DATASET",
+            help="Dataset directory: new, empty, or a dataset to append to.",
+        ),
+    ],
+    query: Annotated[
+        Path | None,
+        typer.Option(
+            "--query",
+            metavar="FILE",
+            help="Query TOML: keep only the rows in its region, time window and vessels. "
+            "Default: all the data.",
+        ),
+    ] = None,
+    fmt: Annotated[
+        str | None,
+        typer.Option(
+            "--format",
+            metavar="LAYOUT",
+            help="Input layout instead of detecting it: dma26, dma22, marinecadastre, nmea, "
+            "parquet.",
+        ),
+    ] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
+) -> None:
+    """Clean AIS files into a Parquet dataset partitioned by date, for stats and replay.
+
+    Writes DATASET/date=YYYY-MM-DD/part-*.parquet (canonical columns, sorted so that a time
+    and region query skips most row groups) and DATASET/colregs9-dataset.json (each input's
+    sha256 and rejects ledger). A file already in the dataset is skipped; a new one (the next
+    day) is added. Give DATASET to stats or replay in place of the files.
+
+    Example: colregs9 ingest fixtures/ais/aisdk_2024-09-09_sample.csv --out reports/ais-dataset
+    """
+    from .ais.dataset import ingest
+
+    with _user_errors():
+        result = ingest(ais, out, query_path=query, fmt=fmt, quiet=quiet)
+    typer.echo(result.text, nl=False)
 
 
 @app.command("swing")

@@ -25,6 +25,8 @@ import numpy as np
 import pandas as pd
 
 DIMENSIONS: tuple[str, ...] = ("length_m", "breadth_m", "draught_m")
+# The columns of the positions ``dimension_stats`` uses: a dataset is read for these alone.
+POSITION_COLUMNS: tuple[str, ...] = ("mmsi", "ship_type", *DIMENSIONS)
 STAT_COLUMNS: tuple[str, ...] = ("count", "mean", "median", "std", "min", "max")
 # Vessels whose ship type is never reported are grouped under this label with ``--by``.
 NO_SHIP_TYPE = "Unknown"

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from enum import StrEnum
+from typing import Any
 
 
 class RejectReason(StrEnum):
@@ -60,6 +62,36 @@ class RejectsLedger:
         """Whether an example of ``reason`` would still be kept (to skip building it)."""
         return len(self.examples.get(reason.value, ())) < self.max_examples
 
+    def merge(self, part: RejectsLedger) -> None:
+        """Add the counts, time sources and (up to ``max_examples``) examples of ``part``."""
+        self.read(part.rows_read)
+        self.use(part.rows_used)
+        self.outside_query(part.rows_outside_query)
+        for reason, count in part.rejects.items():
+            self.rejects[reason] += count
+        self.time_sources.update(part.time_sources)
+        self.time_source_order = self.time_source_order or part.time_source_order
+        for reason, examples in part.examples.items():
+            bucket = self.examples.setdefault(reason, [])
+            bucket.extend(examples[: max(0, self.max_examples - len(bucket))])
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> RejectsLedger:
+        """The ledger ``to_dict`` gave (a dataset manifest keeps its inputs' ledgers);
+        ``KeyError``, ``TypeError`` or ``ValueError`` for anything else."""
+        ledger = cls(
+            rows_read=int(data["rows_read"]),
+            rows_used=int(data["rows_used"]),
+            rows_outside_query=int(data["rows_outside_query"]),
+            rejects=Counter({str(k): int(v) for k, v in data["rejects_by_reason"].items()}),
+            time_sources=Counter({str(k): int(v) for k, v in data.get("time_sources", {}).items()}),
+            time_source_order=tuple(str(s) for s in data.get("time_source_order", ())),
+            examples={str(k): [str(e) for e in v] for k, v in data["reject_examples"].items()},
+        )
+        if ledger.rejected_total != int(data["rows_rejected"]) or not ledger.balanced:
+            raise ValueError("the ledger's counts do not add up")
+        return ledger
+
     @property
     def rejected_total(self) -> int:
         return sum(self.rejects.values())
@@ -75,7 +107,7 @@ class RejectsLedger:
             "rows_outside_query": self.rows_outside_query,
             "rows_rejected": self.rejected_total,
             "rejects_by_reason": dict(sorted(self.rejects.items())),
-            "reject_examples": self.examples,
+            "reject_examples": dict(sorted(self.examples.items())),
             **(
                 {
                     "time_sources": dict(sorted(self.time_sources.items())),

@@ -43,6 +43,13 @@ only for the rows set aside (see csv_chunks.py). A chunk whose numeric columns h
 parsed again with every column as text, and a chunk with a malformed row again on one
 thread, which gives the row's line; the rest of the file is not affected. NMEA is decoded
 whole per file (see nmea.py).
+
+``stream_ais`` reads one file the same way but hands its rows on block by block (a
+``RowSink``), static reports converted too, instead of keeping them: ``colregs9 ingest``
+(dataset.py) writes them to a Parquet dataset. ``load_ais`` reads such a dataset in place of
+files (``_read_dataset``): its rows were cleaned at ingest, so only the query is applied,
+pushed down into the scan (dataset_scan.py), and the dimension reports of the vessels in the
+query are counted over the whole dataset, as over a whole file.
 """
 
 from __future__ import annotations
@@ -53,7 +60,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import TypeAlias
+from typing import TYPE_CHECKING, Protocol, TypeAlias
 
 import numpy as np
 import pandas as pd
@@ -92,7 +99,21 @@ from .sources import (
     sha256_file,
 )
 
-__all__ = ["LAYOUTS", "AisData", "InputFile", "load_ais"]
+if TYPE_CHECKING:
+    from .dataset_scan import Dataset
+    from .nmea import IngestParams
+
+__all__ = [
+    "LAYOUTS",
+    "AisData",
+    "InputFile",
+    "RowSink",
+    "StreamedInput",
+    "load_ais",
+    "rows_in_query",
+    "scan_columns",
+    "stream_ais",
+]
 
 PARQUET_BATCH_ROWS = 256 * 1024
 DIMENSIONS = ("length_m", "breadth_m", "draught_m")
@@ -107,10 +128,14 @@ _SET_ASIDE_BYTES = 8 * 1024 * 1024
 
 @dataclass(frozen=True)
 class InputFile:
+    """One input of a run; ``dataset``: the dataset it was read from (``colregs9 ingest``),
+    where ``path``, ``sha256`` and ``rows_read`` are those of the file ingested."""
+
     path: Path
     sha256: str
     layout: str
     rows_read: int
+    dataset: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -135,34 +160,172 @@ def load_ais(
     fmt: str | None = None,
     quiet: bool = True,
     started: CsvReading | None = None,
+    columns: Sequence[str] | None = None,
 ) -> AisData:
     """Read AIS files (any mix of layouts) through ``query`` into cleaned positions.
 
     ``fmt`` forces the layout of every file (one of ``LAYOUTS``); by default each file's
-    layout is detected from its content. ``started``: the first file, already being read
-    (``csv_read.start_reading``). Raises ``InputFileError`` for unreadable files,
-    ``NoDataError`` (exit code 3) when no position row is left in the query.
+    layout is detected from its content. A directory is read as a Parquet dataset made by
+    ``colregs9 ingest`` (``_read_dataset``; ``fmt`` does not apply to it). ``started``: the
+    first file, already being read (``csv_read.start_reading``). ``columns``: the columns
+    of ``positions`` (default: all, ``CANONICAL_COLUMNS``); a dataset read alone decodes
+    only these and those the query tests (``_dataset_alone``). Raises ``InputFileError``
+    for unreadable files, ``NoDataError`` (exit code 3) when no position row is left in the
+    query.
     """
     query = query if query is not None else everything_query()
+    ingest_params(query)
     if fmt is not None and fmt not in LAYOUTS:
         raise ParameterError(f"--format {fmt!r} is not a layout; use one of {', '.join(LAYOUTS)}")
     if not paths:
         raise InputFileError("no AIS input files given; name at least one file")
-    sources = [inspect_source(Path(p)) for p in paths]
+    wanted = list(CANONICAL_COLUMNS if columns is None else columns)
+    if not set(wanted) <= set(CANONICAL_COLUMNS):
+        raise ParameterError(f"columns {wanted}: give canonical columns ({CANONICAL_COLUMNS})")
+    sources = [_open_input(Path(p)) for p in paths]
     ledger = RejectsLedger()
-    collected = _Collected()
+    collected = _Collected(may_repeat=not _dataset_alone(sources))
+    scanned = scan_columns(wanted, query) if not collected.may_repeat else CANONICAL_COLUMNS
     inputs: list[InputFile] = []
     total_bytes = float(sum(s.size_bytes for s in sources))
     with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet)) as bar:
         for index, source in enumerate(sources):
+            if not isinstance(source, Source):
+                inputs.extend(_read_dataset(source, query, scanned, ledger, collected, bar))
+                continue
             part = _read_source(source, fmt, query, bar, started if index == 0 else None)
-            _merge_ledger(ledger, part.ledger)
+            ledger.merge(part.ledger)
             collected.extend(part)
             inputs.append(InputFile(source.path, part.sha256, part.layout, part.ledger.rows_read))
     positions, dimension_reports = collected.finish(ledger)
+    if positions.empty and ledger.rows_outside_query == 0:
+        raise InputFileError(_no_ais_message(inputs, ledger))
     if positions.empty:
         raise NoDataError(_no_data_message(query, ledger))
+    if columns is not None:
+        positions = positions[wanted]
     return AisData(positions, dimension_reports, ledger, tuple(inputs), len(positions))
+
+
+@dataclass(frozen=True)
+class StreamedInput:
+    """What ``stream_ais`` read of one file. ``ledger`` counts every row but the position
+    rows handed to the sink, which the caller is to use, or reject as duplicates."""
+
+    sha256: str
+    layout: str
+    ledger: RejectsLedger
+
+
+def stream_ais(
+    source: Source, sink: RowSink, query: Query, fmt: str | None, bar: ProgressSink
+) -> StreamedInput:
+    """Read one AIS file as ``load_ais`` does, handing its cleaned rows to ``sink`` block by
+    block instead of keeping them: its memory does not grow with the file (but for NMEA,
+    which is decoded whole, see nmea.py). Static reports go to the sink too. ``bar``
+    advances by the bytes read."""
+    part = _read_source(source, fmt, query, bar, None, sink)
+    return StreamedInput(part.sha256, part.layout, part.ledger)
+
+
+def _dataset_alone(sources: Sequence[Source | Dataset]) -> bool:
+    """One dataset whose inputs share no partition: ingest dropped the duplicates of each,
+    so its rows hold none (and need not be read whole to find them)."""
+    return len(sources) == 1 and not isinstance(sources[0], Source) and sources[0].duplicate_free
+
+
+def scan_columns(wanted: Sequence[str], query: Query) -> tuple[str, ...]:
+    """The columns to read for ``wanted`` columns of the positions in ``query``: also those
+    the query tests, and the sort keys (mmsi, timestamp)."""
+    needed = {*wanted, "mmsi", "timestamp"}
+    if query.region is not None:
+        needed |= {"lat_deg", "lon_deg"}
+    if not query.vessels.selects_all:
+        needed |= {"mobile_type", "ship_type", "length_m"}
+    return tuple(c for c in CANONICAL_COLUMNS if c in needed)
+
+
+def _open_input(path: Path) -> Source | Dataset:
+    if not path.is_dir():
+        return inspect_source(path)
+    from .dataset_scan import Dataset  # pyarrow.dataset: only for runs that read one
+
+    return Dataset.open(path)
+
+
+def _read_dataset(
+    dataset: Dataset,
+    query: Query,
+    columns: Sequence[str],
+    ledger: RejectsLedger,
+    collected: _Collected,
+    bar: ProgressSink,
+) -> tuple[InputFile, ...]:
+    """Read a dataset's positions in the query into ``collected``, with the query pushed
+    down into the scan (``dataset_scan.position_filter``); its static reports and the
+    dimension reports of its vessels are counted at the end (``_Collected.finish``).
+
+    The ledger is the inputs' own (what reading the files themselves counted), with the
+    dataset's rows, all used at ingest, shared out again: the static reports are used, as
+    in a file; the positions this query keeps are used (less duplicates across inputs,
+    found in ``finish``); the others, skipped by the pushdown or by the tests here, are
+    outside the query.
+    """
+    from .dataset_scan import position_filter
+
+    kept = 0
+    for table in dataset.scan(position_filter(query), columns):
+        inside = rows_in_query(table, query)
+        collected.kept.append(table.filter(pa.array(inside)))
+        kept += int(inside.sum())
+    part = dataset.ingest_ledger()
+    part.rows_used = dataset.static_rows
+    part.outside_query(dataset.rows - dataset.static_rows - kept)
+    ledger.merge(part)
+    collected.datasets.append(dataset)
+    bar.advance(dataset.size_bytes)
+    return tuple(
+        InputFile(Path(item.path), item.sha256, item.layout, item.rows_read, dataset.directory)
+        for item in dataset.inputs
+    )
+
+
+def _dataset_reports(dataset: Dataset, vessels: np.ndarray) -> pa.Table:
+    """The dimension reports of ``vessels`` over the whole dataset, positions and static
+    reports, at any time and place, as a file's are counted (``_count_reports``)."""
+    from .dataset_scan import reports_filter
+
+    parts = []
+    for table in dataset.scan(reports_filter(vessels.tolist()), ["mmsi", *DIMENSIONS]):
+        groups = table.group_by(table.column_names, use_threads=False).aggregate(
+            [([], "count_all")]
+        )
+        length_m, breadth_m, draught_m = _canonical_dimensions(groups)
+        reported = any_dimension(length_m, breadth_m, draught_m)
+        parts.append(
+            _report_rows(
+                groups.column("mmsi").to_numpy()[reported],
+                length_m[reported],
+                breadth_m[reported],
+                draught_m[reported],
+                groups.column("count_all").to_numpy()[reported],
+            )
+        )
+        if len(parts) >= _DIMENSION_PARTS_BEFORE_MERGE:
+            parts = [_sum_counts(parts)]
+    empty = np.empty(0)
+    return _sum_counts([_report_rows(empty, empty, empty, empty), *parts])
+
+
+def _no_ais_message(inputs: Sequence[InputFile], ledger: RejectsLedger) -> str:
+    names = ", ".join(str(i.dataset or i.path) for i in inputs)
+    return (
+        f"{names}: no valid AIS position report in {ledger.rows_read} AIS rows read, "
+        f"{ledger.rejected_total} rejected "
+        f"({', '.join(f'{k} {v}' for k, v in sorted(ledger.rejects.items())) or 'none'}); "
+        "check that the input holds AIS messages (NMEA !AIVDM/!AIVDO with valid checksums, or "
+        "a known CSV or Parquet layout, see --format) with valid MMSIs"
+    )
 
 
 def _no_data_message(query: Query, ledger: RejectsLedger) -> str:
@@ -173,19 +336,6 @@ def _no_data_message(query: Query, ledger: RejectsLedger) -> str:
         f"({', '.join(f'{k} {v}' for k, v in sorted(ledger.rejects.items())) or 'none'}); "
         "check the region, time window and vessel filter against the data"
     )
-
-
-def _merge_ledger(into: RejectsLedger, part: RejectsLedger) -> None:
-    into.read(part.rows_read)
-    into.use(part.rows_used)
-    into.outside_query(part.rows_outside_query)
-    for reason, count in part.rejects.items():
-        into.rejects[reason] += count
-    into.time_sources.update(part.time_sources)
-    into.time_source_order = into.time_source_order or part.time_source_order
-    for reason, examples in part.examples.items():
-        bucket = into.examples.setdefault(reason, [])
-        bucket.extend(examples[: max(0, into.max_examples - len(bucket))])
 
 
 # -- one file ---------------------------------------------------------------------------------
@@ -223,6 +373,17 @@ class _Conversion:
     static_text: _StaticText | None
 
 
+class RowSink(Protocol):
+    """Where ``stream_ais`` hands the cleaned rows, block by block, in the canonical schema."""
+
+    def positions(self, table: pa.Table) -> None:
+        """Position rows in the query, not yet checked for duplicates."""
+
+    def statics(self, table: pa.Table) -> None:
+        """Static reports: no position (null lat/lon), a null timestamp where theirs does
+        not parse."""
+
+
 @dataclass
 class _FileResult:
     """What one file contributed; merged into the run only when the file was read whole.
@@ -231,6 +392,9 @@ class _FileResult:
     set aside block by block and converted in batches (``settle``): their other columns are
     wanted for few rows, and converting them a few rows at a time costs more than the
     conversion itself, most of all while the next CSV chunk is parsed on every core.
+
+    With a ``sink`` (``stream_ais``) the position rows go to it instead of ``kept``, and the
+    static reports are converted too and go to it (a load only counts them).
     """
 
     query: Query
@@ -241,14 +405,23 @@ class _FileResult:
     dimension_parts: list[pa.Table] = field(default_factory=list)
     layout: str = ""
     sha256: str = ""
+    sink: RowSink | None = None
     _kept_aside: list[_Part] = field(default_factory=list)
     _static_aside: list[_Part] = field(default_factory=list)
+    _reports_aside: list[_Part] = field(default_factory=list)
     _aside_bytes: int = 0
 
-    def set_aside(self, kept: _Part | None = None, static: _Part | None = None) -> None:
-        """Set aside rows in the region (``kept``) and rows to be told static reports or
-        rows without a position (``static``); settle once enough have gathered."""
-        for part, parts in ((kept, self._kept_aside), (static, self._static_aside)):
+    def set_aside(
+        self, kept: _Part | None = None, static: _Part | None = None, report: _Part | None = None
+    ) -> None:
+        """Set aside rows in the region (``kept``), rows to be told static reports or rows
+        without a position (``static``) and static reports already counted (``report``,
+        only with a sink); settle once enough have gathered."""
+        for part, parts in (
+            (kept, self._kept_aside),
+            (static, self._static_aside),
+            (report, self._reports_aside),
+        ):
             if part is not None:
                 parts.append(part)
                 self._aside_bytes += part.size_bytes if isinstance(part, CutRows) else part.nbytes
@@ -257,12 +430,21 @@ class _FileResult:
 
     def settle(self) -> None:
         """Convert the rows set aside and account for them (steps 4-7 of the module doc)."""
-        kept, static = self._kept_aside, self._static_aside
-        self._kept_aside, self._static_aside, self._aside_bytes = [], [], 0
+        kept, static, reports = self._kept_aside, self._static_aside, self._reports_aside
+        self._kept_aside, self._static_aside, self._reports_aside = [], [], []
+        self._aside_bytes = 0
         for part in self.conversion.convert(static) if static else ():
             self._settle_static(part)
+        for part in self.conversion.convert(reports) if reports else ():
+            self._emit_statics(part.table)
         for part in self.conversion.convert(kept) if kept else ():
             self._settle_kept(part)
+
+    def _emit_statics(self, rows: pa.Table) -> None:
+        """Static reports, converted rows with all their columns, to the sink."""
+        if self.sink is not None and rows.num_rows:
+            table, bad_time = self.conversion.canonical(rows)
+            self.sink.statics(_static_rows(table, bad_time | _time_out_of_range(table)))
 
     def _settle_static(self, part: _Converted) -> None:
         """Rows with neither a position nor a dimension: a static report if they carry
@@ -271,6 +453,8 @@ class _FileResult:
         assert static_text is not None, "rows are set aside as static only with static text"
         present = static_text(part.table)
         self.ledger.use(int(present.sum()))
+        if present.any():
+            self._emit_statics(part.table.filter(pa.array(present)))
         absent = np.flatnonzero(~present)
         reason = RejectReason.NO_POSITION
         if absent.size:
@@ -302,7 +486,10 @@ class _FileResult:
             table = table.filter(pa.array(~bad_time))
         selected = _in_query(table, self.query)
         self.ledger.outside_query(int((~selected).sum()))
-        self.kept.append(table.filter(pa.array(selected)))
+        if self.sink is not None:
+            self.sink.positions(table.filter(pa.array(selected)))
+        else:
+            self.kept.append(table.filter(pa.array(selected)))
 
     def add_dimensions(
         self, mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray
@@ -394,17 +581,22 @@ def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
 
 
 def _read_source(
-    source: Source, fmt: str | None, query: Query, bar: ProgressSink, started: CsvReading | None
+    source: Source,
+    fmt: str | None,
+    query: Query,
+    bar: ProgressSink,
+    started: CsvReading | None,
+    sink: RowSink | None = None,
 ) -> _FileResult:
     if started is not None:
         started.attach_progress(bar)
-        return _read_csv(source, started.layout, query, started)
+        return _read_csv(source, started.layout, query, started, sink)
     head = read_head(source)
     layout = fmt if fmt is not None else detect_layout(source, head)
     if layout == "parquet":
-        return _read_parquet(source, query, bar)
+        return _read_parquet(source, query, bar, sink)
     if layout == "nmea":
-        return _read_nmea(source, query, bar)
+        return _read_nmea(source, query, bar, sink)
     if layout not in CSV_LAYOUTS:
         raise ParameterError(
             f"--format {layout!r} is not a layout; use one of {', '.join(LAYOUTS)}"
@@ -416,7 +608,7 @@ def _read_source(
             f"{source.name}: the {layout} layout needs the column {missing[0]!r}, which the "
             f"header does not have; check the file or the --format given"
         )
-    return _read_csv(source, layout, query, CsvReading(source, layout, header, bar))
+    return _read_csv(source, layout, query, CsvReading(source, layout, header, bar), sink)
 
 
 @dataclass(frozen=True)
@@ -456,10 +648,12 @@ def _csv_layout(layout: str) -> _CsvLayout:
     )
 
 
-def _read_csv(source: Source, layout: str, query: Query, reading: CsvReading) -> _FileResult:
+def _read_csv(
+    source: Source, layout: str, query: Query, reading: CsvReading, sink: RowSink | None
+) -> _FileResult:
     spec = _csv_layout(layout)
     conversion = _Conversion(_csv_conversion(source.name, spec), spec.canonical, spec.static_text)
-    result = _FileResult(query, source.name, conversion, layout=layout)
+    result = _FileResult(query, source.name, conversion, layout=layout, sink=sink)
     with reading:
         try:
             for chunk in reading.chunks():
@@ -579,6 +773,8 @@ def _classify(
         rows = np.flatnonzero(no_position)
         dimensioned = any_dimension(*fields.dimensions.of_rows(rows))
         ledger.use(int(dimensioned.sum()))  # static reports with a dimension
+        if result.sink is not None and dimensioned.any():
+            result.set_aside(report=cut(rows[dimensioned]))
         undecided = np.zeros(len(fields), dtype=bool)
         undecided[rows[~dimensioned]] = True
         if result.conversion.static_text is None:
@@ -609,6 +805,17 @@ def _time_out_of_range(table: pa.Table) -> np.ndarray:
     high = round(AIS_TIME_END.timestamp() * 1000)
     with np.errstate(invalid="ignore"):
         return np.asarray((milliseconds < low) | (milliseconds >= high), dtype=bool)
+
+
+def rows_in_query(table: pa.Table, query: Query) -> np.ndarray:
+    """The position rows of canonical ``table`` inside the query: its region (polygon too),
+    time window and vessel filter."""
+    inside = _in_query(table, query)
+    if query.region is not None:
+        inside &= query.region.contains(
+            to_numpy_float(table.column("lat_deg")), to_numpy_float(table.column("lon_deg"))
+        )
+    return inside
 
 
 def _in_query(table: pa.Table, query: Query) -> np.ndarray:
@@ -690,14 +897,23 @@ def _table_example(name: str, table: pa.Table) -> Example:
     return example
 
 
-def _read_nmea(source: Source, query: Query, bar: ProgressSink) -> _FileResult:
+def ingest_params(query: Query) -> IngestParams:
+    """The query's ``[ingest]`` table, checked (``ParameterError`` naming the file)."""
     from ..config import dataclass_from_table
-    from .nmea import IngestParams, read_nmea
+    from .nmea import IngestParams
 
     where = f"{query.source if query.source is not None else 'query'} [ingest]"
-    ingest = dataclass_from_table(IngestParams, dict(query.tables.get("ingest", {})), where)
+    return dataclass_from_table(IngestParams, dict(query.tables.get("ingest", {})), where)
 
-    result = _FileResult(query, source.name, _table_conversion(source.name, None), layout="nmea")
+
+def _read_nmea(
+    source: Source, query: Query, bar: ProgressSink, sink: RowSink | None
+) -> _FileResult:
+    from .nmea import read_nmea
+
+    ingest = ingest_params(query)
+    conversion = _table_conversion(source.name, None)
+    result = _FileResult(query, source.name, conversion, layout="nmea", sink=sink)
     with open_data(source, bar) as opened:
         text = io.TextIOWrapper(opened.stream, encoding="utf-8", errors="replace", newline="")
         try:
@@ -741,9 +957,36 @@ def _nmea_batch(result: _FileResult, batch: AisBatch) -> None:
     result.ledger.use(int((~bad).sum()))
     dimensions = DimensionColumns(statics.select(list(DIMENSIONS)), _canonical_dimensions)
     result.add_dimensions(mmsi, dimensions, ~bad)
+    if result.sink is not None and not bad.all():
+        result.sink.statics(_statics_canonical(statics.filter(pa.array(~bad))))
 
 
-def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResult:
+def _statics_canonical(statics: pa.Table) -> pa.Table:
+    """NMEA static reports (``STATIC_SCHEMA``) in the canonical schema."""
+    n = statics.num_rows
+    columns = [
+        statics.column(f.name) if f.name in statics.column_names else pa.nulls(n, f.type)
+        for f in CANONICAL_SCHEMA
+    ]
+    table = pa.Table.from_arrays(columns, schema=CANONICAL_SCHEMA)
+    return _static_rows(table, _time_out_of_range(table))
+
+
+def _static_rows(table: pa.Table, bad_time: np.ndarray) -> pa.Table:
+    """Canonical rows as static reports: no position (a static report may carry half of
+    one), and a null timestamp where it does not parse or lies outside the AIS years."""
+    stamps: pa.Array | pa.ChunkedArray = table.column("timestamp")
+    if bad_time.any():
+        stamps = pc.if_else(pa.array(bad_time), pa.scalar(None, stamps.type), stamps)
+    nowhere = pa.nulls(table.num_rows, pa.float64())
+    for name, column in (("timestamp", stamps), ("lat_deg", nowhere), ("lon_deg", nowhere)):
+        table = table.set_column(table.schema.get_field_index(name), name, column)
+    return table
+
+
+def _read_parquet(
+    source: Source, query: Query, bar: ProgressSink, sink: RowSink | None
+) -> _FileResult:
     import pyarrow.parquet as pq  # only here: 20 ms to import, for every CSV run otherwise
 
     if source.compression != "none":
@@ -751,7 +994,7 @@ def _read_parquet(source: Source, query: Query, bar: ProgressSink) -> _FileResul
             f"{source.name}: a compressed Parquet file; give the .parquet file itself"
         )
     conversion = _table_conversion(source.name, _canonical_static_text)
-    result = _FileResult(query, source.name, conversion, layout="parquet")
+    result = _FileResult(query, source.name, conversion, layout="parquet", sink=sink)
     try:
         parquet = pq.ParquetFile(source.path)
     except (pa.ArrowException, OSError) as exc:
@@ -805,6 +1048,10 @@ def _to_canonical(source: Source, table: pa.Table) -> pa.Table:
 class _Collected:
     kept: list[pa.Table] = field(default_factory=list)
     dimension_parts: list[pa.Table] = field(default_factory=list)
+    # Datasets read: their dimension reports are counted for the vessels in the query only.
+    datasets: list[Dataset] = field(default_factory=list)
+    # False when the rows cannot hold exact duplicates (``_dataset_alone``): none are sought.
+    may_repeat: bool = True
 
     def extend(self, part: _FileResult) -> None:
         self.kept.extend(part.kept)
@@ -816,9 +1063,16 @@ class _Collected:
         table = pa.concat_tables(self.kept) if self.kept else CANONICAL_SCHEMA.empty_table()
         positions = _to_pandas(table)
         positions = positions.sort_values(["mmsi", "timestamp"], kind="stable", ignore_index=True)
-        duplicate = positions.duplicated(keep="first").to_numpy()
+        if self.may_repeat:
+            duplicate = positions.duplicated(keep="first").to_numpy()
+        else:
+            duplicate = np.zeros(len(positions), dtype=bool)
         empty = np.empty(0)
-        counts = _sum_counts([_report_rows(empty, empty, empty, empty), *self.dimension_parts])
+        vessels = np.unique(positions["mmsi"].to_numpy())
+        datasets = [_dataset_reports(d, vessels) for d in self.datasets if vessels.size]
+        counts = _sum_counts(
+            [_report_rows(empty, empty, empty, empty), *self.dimension_parts, *datasets]
+        )
         if duplicate.any():
             dropped = positions.loc[duplicate]
             first = dropped.iloc[0]
@@ -851,10 +1105,12 @@ def _subtract_counts(counts: pa.Table, dropped: pd.DataFrame) -> pa.Table:
 
 
 def _to_pandas(table: pa.Table) -> pd.DataFrame:
-    """Canonical columns: int64 MMSI, nullable Int8/Int64 for status and IMO, NaN floats."""
+    """Canonical columns (those of ``table``, in canonical order): int64 MMSI, nullable
+    Int8/Int64 for status and IMO, NaN floats."""
     frame = table.to_pandas()
     frame["mmsi"] = frame["mmsi"].astype(np.int64)
-    frame["nav_status"] = frame["nav_status"].astype("Int8")
-    frame["imo"] = frame["imo"].astype("Int64")
     frame["timestamp"] = pd.to_datetime(frame["timestamp"], utc=True)
-    return frame[list(CANONICAL_COLUMNS)]
+    for name, dtype in (("nav_status", "Int8"), ("imo", "Int64")):
+        if name in frame.columns:
+            frame[name] = frame[name].astype(dtype)
+    return frame[[c for c in CANONICAL_COLUMNS if c in frame.columns]]

@@ -95,12 +95,14 @@ def query_manifest(query: Query) -> dict[str, Any]:
 
 
 def inputs_manifest(inputs: Sequence[InputFile]) -> list[dict[str, Any]]:
+    """Each input file; one read from a dataset (``colregs9 ingest``) names it too."""
     return [
         {
             "path": str(item.path),
             "sha256": item.sha256,
             "layout": item.layout,
             "rows_read": item.rows_read,
+            **({"dataset": str(item.dataset)} if item.dataset is not None else {}),
         }
         for item in inputs
     ]

@@ -1,0 +1,575 @@
+"""``colregs9 ingest``: AIS files into a Parquet dataset, and reading windows of one back.
+
+Layout (``OUT`` is the dataset directory)::
+
+    OUT/colregs9-dataset.json                       the manifest
+    OUT/date=YYYY-MM-DD/part-<sha16>-<n>.parquet    one or more files per input and date
+    OUT/date=__HIVE_DEFAULT_PARTITION__/...         static reports whose time does not parse
+
+``<sha16>`` is the first 16 hex digits of the input file's sha256, ``<n>`` counts the input's
+files in that partition (a new file starts, at an hour boundary, past ``FILE_ROWS``). The
+files hold the canonical schema (``schema.CANONICAL_SCHEMA``; the partition gives ``date``),
+zstd-compressed, in row groups of ``ROW_GROUP_ROWS``. Within a file the positions come
+first, sorted by (hour of timestamp, floor(lat_deg), floor(lon_deg), mmsi, timestamp), so
+that each row group covers about one hour and a band of latitudes: the statistics on
+timestamp, lat_deg and lon_deg let a time and region query skip most row groups. Then the
+static reports (rows without a position that carry static fields, load.py step 4, with
+null lat/lon), in their own row groups, sorted by (hour, mmsi, timestamp): ``stats`` counts
+their dimensions as it does in the files.
+
+The rows are those ``load_ais`` would use under the ingest query (everything by default):
+cleaned the same way, exact duplicates dropped, with the same rejects ledger. Reading the
+dataset with a query gives the positions and ``stats`` that reading the files with that
+query (and the ingest query) gives; the README ("`colregs9 ingest`: datasets") says where
+they differ.
+
+Ingest streams: each input is read block by block (``load.stream_ais``; NMEA is decoded
+whole) and its rows are spilled to per-hour Arrow files in a staging directory inside
+``OUT``; then each hour is sorted, cleared of duplicates and appended to its date's file,
+so that memory holds about one hour of the input. The input's files are moved into place
+and the manifest rewritten (atomically) only once the whole input is written: an input is
+in the dataset whole, or not at all. An input whose sha256 the manifest already lists is
+skipped.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import secrets
+import shutil
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.parquet as pq
+
+from .. import __version__
+from ..errors import InputFileError, NoDataError, OutputError, ParameterError
+from ..progress import ProgressSink, progress_bar, progress_enabled
+from ..query import Query, everything_query, load_query
+from ..report.atomic import write_json
+from ..report.manifest import query_manifest
+from .dataset_scan import (
+    DATASET_FORMAT,
+    FORMAT_VERSION,
+    MANIFEST_NAME,
+    UNDATED,
+    Dataset,
+    DatasetInput,
+    is_dataset,
+    manifest_schema,
+    ms_date,
+    position_filter,
+    read_manifest,
+    utc_ms,
+)
+from .detect import LAYOUTS
+from .ledger import RejectReason, RejectsLedger
+from .load import ingest_params, rows_in_query, scan_columns, stream_ais
+from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
+from .sources import Source, inspect_source, sha256_file
+
+__all__ = [
+    "IngestResult",
+    "IngestedInput",
+    "dataset_time_range",
+    "ingest",
+    "is_dataset",
+    "read_dataset_window",
+]
+
+ROW_GROUP_ROWS = 64 * 1024
+FILE_ROWS = 64 * ROW_GROUP_ROWS
+COMPRESSION = "zstd"
+SORT_ORDER = ("hour of timestamp", "floor(lat_deg)", "floor(lon_deg)", "mmsi", "timestamp")
+_HOUR_MS = 3_600_000
+_UNDATED_HOUR = -1
+# Spill files: fast to write and read back, and lz4 halves the staging's disk use.
+_SPILL_OPTIONS = pa.ipc.IpcWriteOptions(compression="lz4")
+
+
+@dataclass(frozen=True)
+class IngestedInput:
+    """One input of an ingest: written now, or found in the manifest (``already``)."""
+
+    path: Path
+    sha256: str
+    layout: str
+    already: bool
+    ledger: RejectsLedger
+    partitions: dict[str, int]  # date (or UNDATED) -> rows written
+    files: tuple[str, ...]  # relative to the dataset
+    rows_written: int
+
+
+@dataclass(frozen=True)
+class IngestResult:
+    out_dir: Path
+    inputs: tuple[IngestedInput, ...]
+    text: str
+
+
+def ingest(
+    paths: Sequence[Path],
+    out_dir: Path,
+    query_path: Path | None = None,
+    fmt: str | None = None,
+    quiet: bool = True,
+    row_group_rows: int = ROW_GROUP_ROWS,
+) -> IngestResult:
+    """Ingest AIS files into the dataset ``out_dir`` (created if needed; see the module
+    docstring). ``query_path``: keep only the rows in that query. ``fmt`` forces the layout
+    of every file. ``row_group_rows``: rows per Parquet row group.
+
+    Raises ``OutputError`` for an ``out_dir`` that is a file or a non-empty directory that
+    is not a dataset, ``InputFileError`` for unreadable inputs or a broken manifest.
+    """
+    if fmt is not None and fmt not in LAYOUTS:
+        raise ParameterError(f"--format {fmt!r} is not a layout; use one of {', '.join(LAYOUTS)}")
+    if row_group_rows < 1:
+        raise ParameterError(f"row_group_rows {row_group_rows}: give 1 or more")
+    if not paths:
+        raise InputFileError("no AIS input files given; name at least one file")
+    out_dir = Path(out_dir)
+    entries = [item.entry for item in _dataset_inputs(out_dir)]
+    query = load_query(query_path) if query_path is not None else everything_query()
+    ingest_params(query)
+    sources = [inspect_source(Path(p)) for p in paths]
+    known = {entry["sha256"]: entry for entry in entries}
+    hashes = [sha256_file(source.path) for source in sources]
+    new = {h: s for s, h in zip(sources, hashes, strict=True) if h not in known}
+    if new:
+        try:
+            out_dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise _output_error(out_dir, exc) from None
+    results = []
+    total = float(sum(s.size_bytes for s in new.values()))
+    with progress_bar("Reading AIS (bytes)", total, progress_enabled(quiet)) as bar:
+        for source, sha256 in zip(sources, hashes, strict=True):
+            if sha256 in known:
+                results.append(_already(source.path, known[sha256]))
+                continue
+            entry = _ingest_one(source, sha256, out_dir, query, fmt, bar, row_group_rows, quiet)
+            entries.append(entry)
+            known[sha256] = entry
+            _write_manifest(out_dir, entries)
+            results.append(_ingested(entry))
+    inputs = tuple(results)
+    return IngestResult(out_dir, inputs, _summary(out_dir, inputs, entries))
+
+
+def _dataset_inputs(out_dir: Path) -> list[DatasetInput]:
+    """The inputs of the dataset ``out_dir``, or none for a new or empty directory."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise OutputError(
+            f"{out_dir}: --out is a file, not a directory; give a new directory or a dataset"
+        )
+    if (out_dir / MANIFEST_NAME).exists():
+        return read_manifest(out_dir)
+    if out_dir.is_dir() and any(out_dir.iterdir()):
+        raise OutputError(
+            f"{out_dir}: --out holds files but no {MANIFEST_NAME}, so it is not a colregs9 "
+            "dataset; give a new or empty directory, or a dataset made by colregs9 ingest"
+        )
+    return []
+
+
+def _output_error(out_dir: Path, exc: OSError) -> OutputError:
+    where = exc.filename if exc.filename else out_dir
+    return OutputError(
+        f"{out_dir}: cannot write the dataset ({exc.strerror or exc} at {where}); check the "
+        "path, the free space and the permissions, or give another --out"
+    )
+
+
+def _ingest_one(
+    source: Source,
+    sha256: str,
+    out_dir: Path,
+    query: Query,
+    fmt: str | None,
+    bar: ProgressSink,
+    row_group_rows: int,
+    quiet: bool,
+) -> dict[str, Any]:
+    """Read one input into a staging directory, then move its files into the dataset;
+    the manifest entry for it."""
+    try:
+        staging = out_dir / f".ingest-{secrets.token_hex(6)}"
+        staging.mkdir()
+    except OSError as exc:
+        raise _output_error(out_dir, exc) from None
+    try:
+        spill = _Spill(staging / "spill")
+        streamed = stream_ais(source, spill, query, fmt, bar)
+        if streamed.sha256 != sha256:
+            raise InputFileError(
+                f"{source.name}: the file changed while it was being ingested; ingest it again "
+                "once it is complete"
+            )
+        prefix = f"part-{sha256[:16]}"
+        hours = len(spill.files)
+        with progress_bar("Writing partitions (hours)", hours, progress_enabled(quiet)) as done:
+            written = _write_partitions(
+                spill, staging / "out", prefix, row_group_rows, streamed.ledger, done
+            )
+        _install(staging / "out", out_dir, prefix, written)
+    except OSError as exc:
+        raise _output_error(out_dir, exc) from None
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    partitions: dict[str, int] = defaultdict(int)
+    for item in written:
+        partitions[item.date or UNDATED] += item.rows
+    return {
+        "path": str(source.path),
+        "sha256": sha256,
+        "size_bytes": source.size_bytes,
+        "layout": streamed.layout,
+        "query": query_manifest(query),
+        "rows_read": streamed.ledger.rows_read,
+        "ledger": streamed.ledger.to_dict(),
+        "rows_written": sum(item.rows for item in written),
+        "static_rows": sum(item.static_rows for item in written),
+        "partitions": dict(sorted(partitions.items())),
+        "files": [
+            {"path": w.path, "date": w.date, "rows": w.rows, "static_rows": w.static_rows}
+            for w in written
+        ],
+        "ingested_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+
+
+class _Spill:
+    """The ``RowSink`` of an ingest: each block's rows go to Arrow files, one directory per
+    (kind, hour), so that an hour can be read back alone."""
+
+    def __init__(self, directory: Path) -> None:
+        self.directory = directory
+        self.files: dict[tuple[str, int], list[Path]] = defaultdict(list)
+        directory.mkdir()
+
+    def positions(self, table: pa.Table) -> None:
+        self._write("positions", table)
+
+    def statics(self, table: pa.Table) -> None:
+        self._write("statics", table)
+
+    def _write(self, kind: str, table: pa.Table) -> None:
+        if table.num_rows == 0:
+            return
+        hours = _hours(table)
+        order = np.argsort(hours, kind="stable")
+        bounds = np.flatnonzero(np.diff(hours[order])) + 1
+        for rows in np.split(order, bounds):
+            hour = int(hours[rows[0]])
+            folder = self.directory / f"{kind}{hour}"
+            if not self.files[(kind, hour)]:
+                folder.mkdir()
+            path = folder / f"{len(self.files[(kind, hour)]):08d}.arrow"
+            piece = table if len(rows) == table.num_rows else table.take(pa.array(rows))
+            with pa.ipc.new_file(path, CANONICAL_SCHEMA, options=_SPILL_OPTIONS) as writer:
+                writer.write_table(piece)
+            self.files[(kind, hour)].append(path)
+
+    def read(self, kind: str, hour: int) -> pa.Table:
+        """The rows spilled for (kind, hour), in the order they were read."""
+        tables = [pa.ipc.open_file(path).read_all() for path in self.files[(kind, hour)]]
+        return pa.concat_tables(tables)
+
+    def hours(self, kind: str) -> list[int]:
+        return sorted(hour for k, hour in self.files if k == kind)
+
+
+def _hours(table: pa.Table) -> np.ndarray:
+    """Each row's hour since the epoch; ``_UNDATED_HOUR`` for a null timestamp."""
+    stamps = table.column("timestamp")
+    milliseconds = pc.fill_null(stamps.cast(pa.int64()), _UNDATED_HOUR * _HOUR_MS).to_numpy()
+    return np.asarray(milliseconds // _HOUR_MS, dtype=np.int64)
+
+
+def _hour_date(hour: int) -> str | None:
+    return None if hour == _UNDATED_HOUR else ms_date(hour * _HOUR_MS).isoformat()
+
+
+@dataclass(frozen=True)
+class _Written:
+    path: str  # relative to the dataset
+    date: str | None
+    rows: int
+    static_rows: int
+
+
+@dataclass
+class _Duplicates:
+    """The duplicates dropped, and the first of them in (mmsi, timestamp) order, as
+    ``load_ais`` quotes it."""
+
+    count: int = 0
+    first: tuple[int, int] | None = None
+
+    def add(self, dropped: pa.Table) -> None:
+        if dropped.num_rows == 0:
+            return
+        self.count += dropped.num_rows
+        keys = zip(
+            dropped.column("mmsi").to_pylist(),
+            dropped.column("timestamp").cast(pa.int64()).to_pylist(),
+            strict=True,
+        )
+        low = min(keys)
+        self.first = low if self.first is None else min(self.first, low)
+
+    def record(self, ledger: RejectsLedger) -> None:
+        if self.first is None:
+            return
+        mmsi, milliseconds = self.first
+        stamp = pd.Timestamp(milliseconds, unit="ms", tz="UTC")
+        ledger.reject(
+            RejectReason.DUPLICATE,
+            self.count,
+            example=f"MMSI {mmsi} at {stamp}: repeated row",
+        )
+
+
+def _write_partitions(
+    spill: _Spill,
+    staging: Path,
+    prefix: str,
+    row_group_rows: int,
+    ledger: RejectsLedger,
+    bar: ProgressSink,
+) -> list[_Written]:
+    """Write the spilled rows into date partitions under ``staging``, hour by hour; the
+    positions written are used in ``ledger`` and their duplicates rejected."""
+    dates: dict[str | None, dict[str, list[int]]] = defaultdict(lambda: defaultdict(list))
+    for kind in ("positions", "statics"):
+        for hour in spill.hours(kind):
+            dates[_hour_date(hour)][kind].append(hour)
+    duplicates = _Duplicates()
+    written: list[_Written] = []
+    for day in sorted(dates, key=lambda d: (d is None, d or "")):
+        writer = _PartitionWriter(staging, day, prefix, row_group_rows)
+        for hour in dates[day]["positions"]:
+            table, dropped = _drop_duplicates(_sort_for_pruning(spill.read("positions", hour)))
+            duplicates.add(dropped)
+            ledger.use(table.num_rows)
+            writer.write(table, static=False)
+            bar.advance()
+        for hour in dates[day]["statics"]:
+            writer.write(_sort_for_pruning(spill.read("statics", hour)), static=True)
+            bar.advance()
+        written.extend(writer.close())
+    duplicates.record(ledger)
+    return written
+
+
+class _PartitionWriter:
+    """The files of one input in one date partition: a new file at an hour boundary once
+    the current one holds ``FILE_ROWS``."""
+
+    def __init__(self, staging: Path, day: str | None, prefix: str, row_group_rows: int) -> None:
+        self.folder = f"date={day if day is not None else UNDATED}"
+        (staging / self.folder).mkdir(parents=True)
+        self.staging = staging
+        self.day = day
+        self.prefix = prefix
+        self.row_group_rows = row_group_rows
+        self.written: list[_Written] = []
+        self._writer: pq.ParquetWriter | None = None
+        self._rows = 0
+        self._static_rows = 0
+
+    def write(self, table: pa.Table, static: bool) -> None:
+        if self._writer is None or self._rows >= FILE_ROWS:
+            self._close_file()
+            name = f"{self.folder}/{self.prefix}-{len(self.written)}.parquet"
+            self._writer = pq.ParquetWriter(
+                self.staging / name, CANONICAL_SCHEMA, compression=COMPRESSION
+            )
+            self.written.append(_Written(name, self.day, 0, 0))
+        # One write per hour: row groups never span two hours, nor positions and statics.
+        self._writer.write_table(table, row_group_size=self.row_group_rows)
+        self._rows += table.num_rows
+        self._static_rows += table.num_rows if static else 0
+
+    def _close_file(self) -> None:
+        if self._writer is None:
+            return
+        self._writer.close()
+        last = self.written[-1]
+        self.written[-1] = _Written(last.path, last.date, self._rows, self._static_rows)
+        self._writer, self._rows, self._static_rows = None, 0, 0
+
+    def close(self) -> list[_Written]:
+        self._close_file()
+        return self.written
+
+
+def _sort_for_pruning(table: pa.Table) -> pa.Table:
+    """Rows of one hour in the files' order: floor(lat_deg), floor(lon_deg), mmsi,
+    timestamp (a stable sort: rows alike keep the order they were read in)."""
+    keys = pa.table(
+        {
+            "lat_bin": pc.floor(table.column("lat_deg")),
+            "lon_bin": pc.floor(table.column("lon_deg")),
+            "mmsi": table.column("mmsi"),
+            "timestamp": table.column("timestamp"),
+        }
+    )
+    # Nulls (the static reports' bins) sort last.
+    order = pc.sort_indices(keys, sort_keys=[(name, "ascending") for name in keys.column_names])
+    return table.take(order)
+
+
+def _drop_duplicates(table: pa.Table) -> tuple[pa.Table, pa.Table]:
+    """``table`` without rows equal in every column to an earlier one, and the rows dropped.
+
+    Equal rows share their (mmsi, timestamp), and ``table`` must have those rows next to
+    each other (as both sorts here do); only runs of such rows are compared whole, with
+    pandas' equality as ``load_ais`` uses (NaN equals NaN).
+    """
+    if table.num_rows < 2:
+        return table, table.slice(0, 0)
+    mmsi = table.column("mmsi").to_numpy()
+    stamps = table.column("timestamp").cast(pa.int64()).to_numpy()
+    same = (mmsi[1:] == mmsi[:-1]) & (stamps[1:] == stamps[:-1])
+    in_run = np.zeros(table.num_rows, dtype=bool)
+    in_run[1:] |= same
+    in_run[:-1] |= same
+    candidates = np.flatnonzero(in_run)
+    if candidates.size == 0:
+        return table, table.slice(0, 0)
+    repeated = table.take(pa.array(candidates)).to_pandas().duplicated(keep="first").to_numpy()
+    dropped = np.zeros(table.num_rows, dtype=bool)
+    dropped[candidates[repeated]] = True
+    return table.filter(pa.array(~dropped)), table.filter(pa.array(dropped))
+
+
+def _install(staging: Path, out_dir: Path, prefix: str, written: list[_Written]) -> None:
+    """Move the input's files into the dataset, replacing what an interrupted ingest of
+    the same input may have left (its files bear its name but are in no manifest)."""
+    for leftover in out_dir.glob(f"date=*/{prefix}-*.parquet"):
+        leftover.unlink()
+    for item in written:
+        target = out_dir / item.path
+        target.parent.mkdir(exist_ok=True)
+        os.replace(staging / item.path, target)
+
+
+def _write_manifest(out_dir: Path, entries: list[dict[str, Any]]) -> None:
+    manifest = {
+        "format": DATASET_FORMAT,
+        "format_version": FORMAT_VERSION,
+        "tool": "colregs9",
+        "version": __version__,
+        "schema": manifest_schema(),
+        "partitioning": {"flavor": "hive", "field": "date", "type": "date32", "null": UNDATED},
+        "sort_order": list(SORT_ORDER),
+        "static_reports": "after the positions of each file, lat_deg and lon_deg null",
+        "compression": COMPRESSION,
+        "inputs": entries,
+    }
+    write_json(out_dir / MANIFEST_NAME, manifest)
+
+
+def _already(path: Path, entry: dict[str, Any]) -> IngestedInput:
+    return dataclasses.replace(_ingested(entry), path=path, already=True)
+
+
+def _ingested(entry: dict[str, Any]) -> IngestedInput:
+    return IngestedInput(
+        path=Path(entry["path"]),
+        sha256=entry["sha256"],
+        layout=entry["layout"],
+        already=False,
+        ledger=RejectsLedger.from_dict(entry["ledger"]),
+        partitions=dict(entry["partitions"]),
+        files=tuple(f["path"] for f in entry["files"]),
+        rows_written=int(entry["rows_written"]),
+    )
+
+
+def _summary(
+    out_dir: Path, inputs: tuple[IngestedInput, ...], entries: list[dict[str, Any]]
+) -> str:
+    lines = []
+    for item in inputs:
+        if item.already:
+            lines.append(f"{item.path}: already ingested (sha256 {item.sha256[:16]}…), skipped")
+            continue
+        lines.append(f"{item.path} ({item.layout}): {item.rows_written} rows written")
+        for day, rows in item.partitions.items():
+            lines.append(f"  date={day}: {rows} rows")
+        ledger = item.ledger
+        reasons = ", ".join(f"{k} {v}" for k, v in sorted(ledger.rejects.items())) or "none"
+        lines.append(
+            f"  ledger: {ledger.rows_read} read, {ledger.rows_used} used, "
+            f"{ledger.rows_outside_query} outside the query, {ledger.rejected_total} rejected "
+            f"({reasons})"
+        )
+    ingested = sum(not item.already for item in inputs)
+    partitions = {day for entry in entries for day in entry["partitions"]}
+    rows = sum(int(entry["rows_written"]) for entry in entries)
+    lines.append(
+        f"{ingested} input(s) ingested, {len(inputs) - ingested} already ingested; the dataset "
+        f"{out_dir} holds {len(entries)} input(s), {rows} rows in {len(partitions)} partition(s)"
+    )
+    return "\n".join(lines) + "\n"
+
+
+# -- reading ----------------------------------------------------------------------------------
+
+
+def read_dataset_window(
+    dataset_dir: Path | Dataset,
+    query: Query,
+    start: datetime,
+    end: datetime,
+    columns: Sequence[str] | None = None,
+) -> pa.Table:
+    """The positions of the dataset with ``start <= timestamp < end`` inside ``query``
+    (region, polygon too, time window and vessel filter), sorted by (mmsi, timestamp),
+    exact duplicates dropped; an empty table if there are none.
+
+    ``columns``: the columns of the table (default: all, ``CANONICAL_SCHEMA``). The query,
+    the window and the columns are pushed down into the scan (partitions and row groups
+    skipped, other columns not decoded; all are read where two inputs share a date, to find
+    duplicates). ``dataset_dir`` may be a ``Dataset`` already opened, which saves checking
+    its files again for every window. ``start`` and ``end`` are timezone-aware.
+    """
+    dataset = dataset_dir if isinstance(dataset_dir, Dataset) else Dataset.open(dataset_dir)
+    wanted = list(CANONICAL_COLUMNS if columns is None else columns)
+    read = scan_columns(wanted, query) if dataset.duplicate_free else CANONICAL_COLUMNS
+    expression = position_filter(query, utc_ms(start), utc_ms(end))
+    tables = [
+        table.filter(pa.array(rows_in_query(table, query)))
+        for table in dataset.scan(expression, read)
+    ]
+    schema = pa.schema([CANONICAL_SCHEMA.field(name) for name in read])
+    table = pa.concat_tables(tables) if tables else schema.empty_table()
+    order = pc.sort_indices(table, sort_keys=[("mmsi", "ascending"), ("timestamp", "ascending")])
+    table = table.take(order)
+    if not dataset.duplicate_free:
+        table, _ = _drop_duplicates(table)
+    return table.select(wanted)
+
+
+def dataset_time_range(dataset_dir: Path | Dataset) -> tuple[datetime, datetime]:
+    """The first and last timestamps (UTC) of the dataset's positions, from the Parquet
+    row-group statistics alone (no data read). ``NoDataError`` if it holds no position."""
+    dataset = dataset_dir if isinstance(dataset_dir, Dataset) else Dataset.open(dataset_dir)
+    found = dataset.time_range()
+    if found is None:
+        raise NoDataError(f"{dataset.directory}: the dataset holds no positions")
+    first, last = found
+    return first.astimezone(UTC), last.astimezone(UTC)

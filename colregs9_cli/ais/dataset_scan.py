@@ -1,0 +1,351 @@
+"""Reading a Parquet dataset made by ``colregs9 ingest``: its manifest, its files, its scans.
+
+A dataset is a directory holding ``colregs9-dataset.json`` (the manifest) and Parquet files
+in the canonical schema under hive partitions ``date=YYYY-MM-DD/`` (``date=__HIVE_DEFAULT_
+PARTITION__/`` for static reports whose time does not parse). See ``dataset.py`` for how it
+is written. Opening one (``Dataset.open``) checks it whole against its manifest, from the
+manifest and the files' footers only: every listed file is there with the canonical schema
+and the row count listed, and no other Parquet file lies in it. The scans are
+``pyarrow.dataset`` scans with the query pushed down: the time window prunes partitions and,
+with the region, row groups by their statistics; only the columns asked for are decoded.
+
+Used by ``load.load_ais`` (so a dataset is accepted wherever AIS files are) and by
+``dataset.py``; it imports neither.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from datetime import UTC, date, datetime, timedelta
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+import pyarrow.dataset as ds
+
+from ..errors import InputFileError
+from ..query import Query
+from .ledger import RejectsLedger
+from .schema import CANONICAL_SCHEMA
+
+MANIFEST_NAME = "colregs9-dataset.json"
+DATASET_FORMAT = "colregs9-dataset"
+FORMAT_VERSION = 1
+PARTITION_FIELD = pa.field("date", pa.date32())
+# The hive convention for a null partition value (Spark, DuckDB and polars read it so too).
+UNDATED = "__HIVE_DEFAULT_PARTITION__"
+DATASET_SCHEMA = CANONICAL_SCHEMA.append(PARTITION_FIELD)
+_PARTITIONING = ds.HivePartitioning(pa.schema([PARTITION_FIELD]), null_fallback=UNDATED)
+_EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
+_REMEDY = "re-create the dataset with colregs9 ingest"
+
+
+def is_dataset(path: Path) -> bool:
+    """A directory with a dataset manifest (it may still prove broken when opened)."""
+    return Path(path).is_dir() and (Path(path) / MANIFEST_NAME).is_file()
+
+
+def manifest_schema() -> list[dict[str, str]]:
+    """The canonical schema as the manifest records it."""
+    return [{"name": f.name, "type": str(f.type)} for f in CANONICAL_SCHEMA]
+
+
+def utc_ms(moment: datetime) -> int:
+    """Milliseconds since the epoch, the schema's unit (rounded as ``load._in_query`` does)."""
+    return round(moment.timestamp() * 1000)
+
+
+def ms_date(milliseconds: int) -> date:
+    return (_EPOCH + timedelta(milliseconds=milliseconds)).date()
+
+
+@dataclass(frozen=True)
+class DatasetFile:
+    """One Parquet file: its path relative to the dataset, partition date (None: undated)
+    and rows."""
+
+    path: str
+    date: str | None
+    rows: int
+
+
+@dataclass(frozen=True)
+class DatasetInput:
+    """One ingested input as the manifest records it (``entry``: the whole record)."""
+
+    path: str
+    sha256: str
+    layout: str
+    rows_read: int
+    ledger: RejectsLedger
+    files: tuple[DatasetFile, ...]
+    entry: dict[str, Any]
+
+
+def read_manifest(directory: Path) -> list[DatasetInput]:
+    """The inputs the dataset manifest in ``directory`` lists, checked; ``InputFileError``
+    for a missing, unreadable or malformed manifest."""
+    path = Path(directory) / MANIFEST_NAME
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputFileError(
+            f"{directory}: a directory without {MANIFEST_NAME}, so not a colregs9 dataset; "
+            "give AIS files, or a dataset directory made by colregs9 ingest"
+        ) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputFileError(
+            f"{path}: cannot read the dataset manifest ({exc}); {_REMEDY}"
+        ) from None
+    try:
+        manifest = json.loads(text)
+    except ValueError as exc:
+        raise InputFileError(
+            f"{path}: the dataset manifest is not valid JSON ({exc}); restore it, or {_REMEDY}"
+        ) from None
+    if not isinstance(manifest, dict) or manifest.get("format") != DATASET_FORMAT:
+        raise InputFileError(f"{path}: not a colregs9 dataset manifest; {_REMEDY}")
+    if manifest.get("format_version") != FORMAT_VERSION:
+        raise InputFileError(
+            f"{path}: dataset format version {manifest.get('format_version')!r}, this colregs9 "
+            f"reads version {FORMAT_VERSION}; use the colregs9 that wrote it, or {_REMEDY}"
+        )
+    if manifest.get("schema") != manifest_schema():
+        raise InputFileError(
+            f"{path}: the manifest's schema is not the canonical schema of this colregs9; {_REMEDY}"
+        )
+    entries = manifest.get("inputs")
+    if not isinstance(entries, list):
+        raise InputFileError(f"{path}: the manifest has no list of inputs; {_REMEDY}")
+    inputs = []
+    for number, entry in enumerate(entries, start=1):
+        try:
+            inputs.append(_input(entry))
+        except (KeyError, TypeError, ValueError, AttributeError) as exc:
+            raise InputFileError(
+                f"{path}: input {number} of the manifest is malformed ({exc!r}); {_REMEDY}"
+            ) from None
+    return inputs
+
+
+def _input(entry: dict[str, Any]) -> DatasetInput:
+    files = tuple(
+        DatasetFile(str(f["path"]), None if f["date"] is None else str(f["date"]), int(f["rows"]))
+        for f in entry["files"]
+    )
+    ledger = RejectsLedger.from_dict(entry["ledger"])
+    written = int(entry["rows_written"])
+    if written != sum(f.rows for f in files) or written != ledger.rows_used:
+        raise ValueError("rows_written does not match its files and its ledger")
+    return DatasetInput(
+        path=str(entry["path"]),
+        sha256=str(entry["sha256"]),
+        layout=str(entry["layout"]),
+        rows_read=ledger.rows_read,
+        ledger=ledger,
+        files=files,
+        entry=entry,
+    )
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """An opened, checked dataset (see the module docstring)."""
+
+    directory: Path
+    inputs: tuple[DatasetInput, ...]
+    arrow: ds.FileSystemDataset
+    static_rows: int  # rows without a position (static reports), from the footers
+
+    @classmethod
+    def open(cls, directory: Path) -> Dataset:
+        directory = Path(directory)
+        inputs = tuple(read_manifest(directory))
+        listed = [f for item in inputs for f in item.files]
+        names = {f.path for f in listed}
+        for found in sorted(directory.rglob("*.parquet")):
+            relative = found.relative_to(directory)
+            if relative.as_posix() not in names and not _hidden(relative):
+                raise InputFileError(
+                    f"{found}: a Parquet file the dataset manifest does not list (a dataset "
+                    "holds only what colregs9 ingest wrote); move it out of the dataset, or "
+                    "ingest its source"
+                )
+        for listed_file in listed:
+            if not (directory / listed_file.path).is_file():
+                raise InputFileError(
+                    f"{directory / listed_file.path}: listed in the dataset manifest but "
+                    f"missing; restore it, or {_REMEDY}"
+                )
+        try:
+            arrow = ds.dataset(
+                [str(directory / f.path) for f in listed],
+                schema=DATASET_SCHEMA,
+                format="parquet",
+                partitioning=_PARTITIONING,
+                partition_base_dir=str(directory),
+            )
+        except (pa.ArrowException, OSError) as exc:
+            raise InputFileError(
+                f"{directory}: cannot open the dataset ({exc}); {_REMEDY}"
+            ) from None
+        static_rows = sum(
+            _check_fragment(fragment, listed_file, directory / listed_file.path)
+            for fragment, listed_file in zip(arrow.get_fragments(), listed, strict=True)
+        )
+        return cls(directory, inputs, arrow, static_rows)
+
+    @property
+    def rows(self) -> int:
+        return sum(f.rows for item in self.inputs for f in item.files)
+
+    @property
+    def size_bytes(self) -> int:
+        return sum((self.directory / f.path).stat().st_size for f in self.files)
+
+    @property
+    def files(self) -> tuple[DatasetFile, ...]:
+        return tuple(f for item in self.inputs for f in item.files)
+
+    @property
+    def duplicate_free(self) -> bool:
+        """No two inputs share a partition: ingest dropped each input's exact duplicates,
+        and duplicates share their timestamp, hence their partition."""
+        dates = [{f.date for f in item.files if f.date is not None} for item in self.inputs]
+        return sum(len(d) for d in dates) == len(set().union(*dates))
+
+    def ingest_ledger(self) -> RejectsLedger:
+        """The ledgers of the inputs, merged: what reading the files themselves counted."""
+        ledger = RejectsLedger()
+        for item in self.inputs:
+            ledger.merge(item.ledger)
+        return ledger
+
+    def scan(self, expression: ds.Expression, columns: Sequence[str]) -> Iterator[pa.Table]:
+        """The rows ``expression`` selects, with ``columns``, batch by batch in file order."""
+        try:
+            for batch in self.arrow.to_batches(filter=expression, columns=list(columns)):
+                if batch.num_rows:
+                    yield pa.Table.from_batches([batch])
+        except (pa.ArrowException, OSError) as exc:
+            raise InputFileError(
+                f"{self.directory}: cannot read the dataset ({exc}); {_REMEDY}"
+            ) from None
+
+    def time_range(self) -> tuple[datetime, datetime] | None:
+        """The first and last timestamps of the position rows, from the row groups'
+        statistics (row groups of static reports left out); None without positions."""
+        lat = CANONICAL_SCHEMA.get_field_index("lat_deg")
+        stamp = CANONICAL_SCHEMA.get_field_index("timestamp")
+        first: datetime | None = None
+        last: datetime | None = None
+        for fragment in self.arrow.get_fragments():
+            metadata = fragment.metadata
+            for index in range(metadata.num_row_groups):
+                group = metadata.row_group(index)
+                lat_stats = group.column(lat).statistics
+                stats = group.column(stamp).statistics
+                if lat_stats is not None and lat_stats.null_count == group.num_rows:
+                    continue
+                if stats is None or not stats.has_min_max:
+                    raise InputFileError(
+                        f"{fragment.path}: row group {index} has no timestamp statistics; {_REMEDY}"
+                    )
+                first = stats.min if first is None else min(first, stats.min)
+                last = stats.max if last is None else max(last, stats.max)
+        return None if first is None or last is None else (first, last)
+
+
+def _hidden(relative: Path) -> bool:
+    """Paths pyarrow's discovery would skip too: an ingest's staging directory."""
+    return any(part.startswith((".", "_")) for part in relative.parts)
+
+
+def _check_fragment(fragment: ds.ParquetFileFragment, listed: DatasetFile, path: Path) -> int:
+    """Read the file's footer (kept for the scans), check it against the manifest and
+    the canonical schema, and give its number of static rows (null latitudes)."""
+    try:
+        fragment.ensure_complete_metadata()
+        schema = fragment.physical_schema
+        metadata = fragment.metadata
+    except (pa.ArrowException, OSError) as exc:
+        raise InputFileError(f"{path}: not a readable Parquet file ({exc}); {_REMEDY}") from None
+    for expected in CANONICAL_SCHEMA:
+        if expected.name not in schema.names:
+            raise InputFileError(
+                f"{path}: lacks the canonical column {expected.name!r}; not a file of this "
+                f"dataset: move it out, or {_REMEDY}"
+            )
+        found = schema.field(expected.name).type
+        if found != expected.type:
+            raise InputFileError(
+                f"{path}: column {expected.name!r} is {found}, the canonical schema has "
+                f"{expected.type}; not a file of this dataset: move it out, or {_REMEDY}"
+            )
+    if len(schema) != len(CANONICAL_SCHEMA):
+        extra = next(name for name in schema.names if name not in CANONICAL_SCHEMA.names)
+        raise InputFileError(
+            f"{path}: has the column {extra!r}, which the canonical schema has not; not a "
+            f"file of this dataset: move it out, or {_REMEDY}"
+        )
+    if metadata.num_rows != listed.rows:
+        raise InputFileError(
+            f"{path}: holds {metadata.num_rows} rows, the manifest lists {listed.rows}; {_REMEDY}"
+        )
+    lat = CANONICAL_SCHEMA.get_field_index("lat_deg")
+    static = 0
+    for index in range(metadata.num_row_groups):
+        stats = metadata.row_group(index).column(lat).statistics
+        if stats is None:  # a writer without statistics: count them
+            return int(fragment.count_rows(filter=ds.field("lat_deg").is_null()))
+        static += stats.null_count
+    return static
+
+
+def position_filter(
+    query: Query, start_ms: int | None = None, end_ms: int | None = None
+) -> ds.Expression:
+    """The pushdown of ``query`` (and of ``[start_ms, end_ms)``) for the position rows:
+    partitions by date, row groups by the statistics of timestamp, lat_deg, lon_deg, mmsi
+    and length_m. Exact for the box, the window and the vessel filter but its ship types;
+    the caller still tests the polygon and the ship types."""
+    lat, lon = ds.field("lat_deg"), ds.field("lon_deg")
+    expression = lat.is_valid() & lon.is_valid()
+    region = query.region
+    if region is not None:
+        expression &= (lat >= region.lat_min) & (lat <= region.lat_max)
+        expression &= (lon >= region.lon_min) & (lon <= region.lon_max)
+    window = query.time
+    starts = [start_ms, None if window.start is None else utc_ms(window.start)]
+    ends = [end_ms, None if window.end is None else utc_ms(window.end)]
+    stamp, day = ds.field("timestamp"), ds.field("date")
+    if any(m is not None for m in starts):
+        start = max(m for m in starts if m is not None)
+        expression &= (day >= ms_date(start)) & (stamp >= _timestamp(start))
+    if any(m is not None for m in ends):
+        end = min(m for m in ends if m is not None)
+        expression &= (day <= ms_date(end - 1)) & (stamp < _timestamp(end))
+    vessels = query.vessels
+    mmsi = ds.field("mmsi")
+    if vessels.mmsi_include is not None:
+        expression &= mmsi.isin(sorted(vessels.mmsi_include))
+    if vessels.mmsi_exclude:
+        expression &= ~mmsi.isin(sorted(vessels.mmsi_exclude))
+    if vessels.mobile_types is not None:
+        expression &= ds.field("mobile_type").isin(sorted(vessels.mobile_types))
+    if vessels.length_min_m is not None:
+        expression &= ds.field("length_m") >= vessels.length_min_m
+    if vessels.length_max_m is not None:
+        expression &= ds.field("length_m") <= vessels.length_max_m
+    return expression
+
+
+def reports_filter(vessels: Sequence[int]) -> ds.Expression:
+    """Every row (positions and static reports, any time and place) of these vessels."""
+    return ds.field("mmsi").isin(pa.array(vessels, pa.int64()))
+
+
+def _timestamp(milliseconds: int) -> pa.Scalar:
+    return pa.scalar(milliseconds, type=CANONICAL_SCHEMA.field("timestamp").type)
