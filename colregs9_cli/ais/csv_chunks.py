@@ -410,6 +410,7 @@ def _parse_numbers_or_text(
     number column holds text. Returns the table and whether it was read as text. Malformed
     rows are skipped and go to ``invalid``.
     """
+    block_bytes = PARSE_BLOCK_BYTES
     while True:
         found: list[tuple[int | None, int, int, str]] = []
 
@@ -419,9 +420,11 @@ def _parse_numbers_or_text(
 
         types = {c: _type(c, layout, text) for c in columns}
         try:
-            table = _parse(data, layout.names, types, threads, invalid_row)
+            table = _parse(data, layout.names, types, threads, invalid_row, block_bytes)
         except pa.ArrowInvalid as exc:
-            if threads and found:
+            if "straddles" in str(exc) and block_bytes <= len(data):
+                block_bytes = len(data) + 1  # a line longer than a block: one block
+            elif threads and found:
                 threads = False
             elif not text and "conversion error" in str(exc):
                 text = True
@@ -470,11 +473,12 @@ def _parse(
     types: Mapping[str, pa.DataType],
     threads: bool,
     invalid_row: Any = None,
+    block_bytes: int = PARSE_BLOCK_BYTES,
 ) -> pa.Table:
     return pacsv.read_csv(
         pa.BufferReader(pa.py_buffer(data)),
         read_options=pacsv.ReadOptions(
-            column_names=list(names), block_size=PARSE_BLOCK_BYTES, use_threads=threads
+            column_names=list(names), block_size=block_bytes, use_threads=threads
         ),
         parse_options=pacsv.ParseOptions(invalid_row_handler=invalid_row),
         convert_options=pacsv.ConvertOptions(
