@@ -222,7 +222,10 @@ def segment_reports(
     carried = np.r_[np.ones(len(carry), dtype=bool), np.zeros(len(reports), dtype=bool)]
     mmsi_all = rows["mmsi"].to_numpy(dtype=np.int64)
     t_all = rows["t_s"].to_numpy(dtype=float)
-    order = np.lexsort((t_all, mmsi_all))
+    # Of two reports at the same time the first in this order is kept: by their values,
+    # not by the order of the input rows, so that the files' order cannot change a track.
+    values = [rows[name].to_numpy(dtype=float) for name in reversed(REPORT_COLUMNS[2:])]
+    order = np.lexsort((*values, ~carried, t_all, mmsi_all))
     mmsi, t = mmsi_all[order], t_all[order]
 
     new_time = np.ones(len(t), dtype=bool)

@@ -305,9 +305,9 @@ def test_a_bad_row_costs_its_chunk_not_the_file(
     parses: list[bool] = []
     parse = csv_chunks._parse
 
-    def recording_parse(data, names, types, threads, invalid_row=None):  # type: ignore[no-untyped-def]
+    def recording_parse(data, names, types, threads, *args):  # type: ignore[no-untyped-def]
         parses.append(threads)
-        return parse(data, names, types, threads, invalid_row)
+        return parse(data, names, types, threads, *args)
 
     monkeypatch.setattr(csv_chunks, "_parse", recording_parse)
     monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", 700)
