@@ -1,6 +1,7 @@
 """``colregs9 replay``: historical AIS, pair by pair, through G_a and G_d (DESIGN §5).
 
-The pipeline: read the AIS through the query → the run's local frame (the query's region, or
+The pipeline, slab by slab in time (``replay_input.py`` reads the AIS through the query one
+slab at a time, ``slabs.py`` segments and evaluates them): the run's local frame (the query's region, or
 the extent of the data when the query has none) → per-vessel tracks (``tracks.py``; reports
 dropped as same-second duplicates or speed jumps go into the rejects ledger) → encounters
 (``encounters.py``) → for each triggered pair, evaluated once for both seats:
@@ -45,7 +46,7 @@ import numpy as np
 import pandas as pd
 
 from .ais.ledger import RejectReason, RejectsLedger
-from .ais.load import AisData, load_ais
+from .ais.load import InputFile
 from .audit import (
     INSUFFICIENT_CONDUCT,
     Conduct,
@@ -74,6 +75,7 @@ from .manoeuvrability import (
 )
 from .progress import progress_bar, progress_enabled
 from .query import Query, everything_query, load_query
+from .replay_input import open_replay_input
 from .replay_params import ReplayParams, replay_params_from_table
 from .replay_results import (
     SERIES_COLUMNS,
@@ -98,11 +100,12 @@ from .slabs import (
     SlabResult,
     run_slabs,
     segment_slabs,
-    slab_of,
-    slabs_of_frame,
 )
-from .tracks import Tracks, TrackStats
+from .tracks import REQUIRED_COLUMNS, STATIC_COLUMNS, Tracks, TrackStats, context_s
 from .vessel_defaults import VesselDimensions, vessel_dimensions
+
+# The canonical columns a replay reads: those of the reports and the static data.
+REPLAY_COLUMNS: tuple[str, ...] = (*REQUIRED_COLUMNS, *STATIC_COLUMNS)
 
 
 def default_out_dir(query_name: str) -> Path:
@@ -778,7 +781,7 @@ def load_run_chart(
 
 def build_manifest(
     query: Query,
-    data: AisData,
+    inputs: Sequence[InputFile],
     ledger: RejectsLedger,
     chart: Chart | None,
     chart_paths: Sequence[Path],
@@ -794,7 +797,7 @@ def build_manifest(
         "query": query_manifest(query),
         "frame": {"lat0_deg": frame.lat0_deg, "lon0_deg": frame.lon0_deg},
         "parameters": jsonable(params),
-        "inputs": inputs_manifest(data.inputs),
+        "inputs": inputs_manifest(inputs),
         "charts": charts_manifest(chart_paths),
         "chart_cells": [jsonable(cell) for cell in (chart.cells if chart is not None else ())],
         "ledger": ledger.to_dict(),
@@ -854,29 +857,30 @@ def run_replay(
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
         if write:
             check_out_dir(target, overwrite)
-        data = load_ais(ais_paths, query=query, fmt=fmt, quiet=quiet)
-        vessels_in_data = data.positions["mmsi"].nunique()
-        if vessels_in_data < 2:
-            raise NoDataError(
-                f"{', '.join(str(p) for p in ais_paths)}: the AIS selected by query "
-                f"'{query.name}' holds {vessels_in_data} vessel(s); an encounter needs two. "
-                "Widen the query or give more AIS"
-            )
-        source = read_charts(chart_paths, accept_chart_gaps) if chart_paths else None
         slab_s = params.replay.slab_s
         with tempfile.TemporaryDirectory(prefix="colregs9-slabs-", dir=scratch_dir) as scratch:
-            by_slab = slabs_of_frame(data.positions, slab_s)
-            count = len(np.unique(slab_of(data.positions["timestamp"], slab_s)))
-            with progress_bar("tracks (slabs)", count, progress_enabled(quiet)) as bar:
-                segmentation = segment_slabs(by_slab, Path(scratch), params.replay, bar)
-            data = dataclasses.replace(data, positions=data.positions.iloc[:0])
+            spill_dir = Path(scratch) / "spill"
+            spill_dir.mkdir()
+            ais = open_replay_input(
+                ais_paths, query, fmt, quiet, Path(scratch), slab_s, REPLAY_COLUMNS
+            )
+            with progress_bar("tracks (slabs)", len(ais.slabs), progress_enabled(quiet)) as bar:
+                segmentation = segment_slabs(ais.positions(), spill_dir, params.replay, bar)
+            ais.check_positions()
+            if len(ais.vessels) < 2:
+                raise NoDataError(
+                    f"{', '.join(str(p) for p in ais_paths)}: the AIS selected by query "
+                    f"'{query.name}' holds {len(ais.vessels)} vessel(s); an encounter needs "
+                    "two. Widen the query or give more AIS"
+                )
+            source = read_charts(chart_paths, accept_chart_gaps) if chart_paths else None
             _check_own(params.own_mmsi, segmentation.vessels)
             frame = run_frame(query, segmentation.extent, source)
             chart: Chart | None = None
             if source is not None:
                 chart = load_run_chart(source, chart_paths, frame, segmentation.points)
             context = slab_context(segmentation, frame, params)
-            slabs = slab_range(segmentation, params.replay.slab_s)
+            slabs = slab_range(segmentation, params.replay)
             evaluate = functools.partial(_evaluate, params=params)
             with progress_bar("pairs (slabs)", len(slabs), progress_enabled(quiet)) as bar:
                 if cluster is None:
@@ -886,14 +890,14 @@ def run_replay(
 
                     results = dask_slabs(cluster, slabs, context, evaluate, chart, bar)
         outcomes = [pair for result in results for pair in result.pairs]
-        ledger = _ledger_with_tracks(data.ledger, segmentation.stats)
+        ledger = _ledger_with_tracks(ais.ledger, segmentation.stats)
         track_stats = dataclasses.replace(
             segmentation.stats, samples=sum(r.samples for r in results)
         )
         counts = _counts(segmentation, results)
         manifest = build_manifest(
             query,
-            data,
+            ais.inputs,
             ledger,
             chart,
             chart_paths,
@@ -951,15 +955,20 @@ def _check_own(own_mmsi: Sequence[int], vessels: np.ndarray) -> None:
         )
 
 
-def slab_range(segmentation: Segmentation, slab_s: float) -> list[int]:
-    """The slabs from the first decided report's to the last's."""
-    if not segmentation.spill.files:
-        return []
-    return list(
-        range(
-            math.floor(segmentation.first_s / slab_s), math.floor(segmentation.last_s / slab_s) + 1
-        )
-    )
+def slab_range(segmentation: Segmentation, params: ReplayParams) -> list[int]:
+    """The slabs whose core the decided reports reach, with the context resampling needs
+    around them (``tracks.context_s``): a slab far from any report can start no encounter,
+    so a gap of months in the data costs nothing."""
+    slab_s = params.slab_s
+    margin_s = context_s(params)
+    first = math.floor(segmentation.first_s / slab_s) if segmentation.spill.files else 0
+    last = math.floor(segmentation.last_s / slab_s) if segmentation.spill.files else -1
+    slabs: set[int] = set()
+    for spilled in segmentation.spill.files:
+        low = max(first, math.floor((spilled.t_min_s - margin_s) / slab_s))
+        high = min(last, math.floor((spilled.t_max_s + margin_s) / slab_s))
+        slabs.update(range(low, high + 1))
+    return sorted(slabs)
 
 
 def slab_context(

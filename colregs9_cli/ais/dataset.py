@@ -82,8 +82,10 @@ __all__ = [
     "IngestedInput",
     "dataset_time_range",
     "ingest",
+    "ingest_with_query",
     "is_dataset",
     "read_dataset_window",
+    "read_window_counted",
 ]
 
 ROW_GROUP_ROWS = 64 * 1024
@@ -132,6 +134,19 @@ def ingest(
     Raises ``OutputError`` for an ``out_dir`` that is a file or a non-empty directory that
     is not a dataset, ``InputFileError`` for unreadable inputs or a broken manifest.
     """
+    query = load_query(query_path) if query_path is not None else everything_query()
+    return ingest_with_query(paths, out_dir, query, fmt, quiet, row_group_rows)
+
+
+def ingest_with_query(
+    paths: Sequence[Path],
+    out_dir: Path,
+    query: Query,
+    fmt: str | None = None,
+    quiet: bool = True,
+    row_group_rows: int = ROW_GROUP_ROWS,
+) -> IngestResult:
+    """``ingest`` with the query already loaded (replay ingests its files this way)."""
     if fmt is not None and fmt not in LAYOUTS:
         raise ParameterError(f"--format {fmt!r} is not a layout; use one of {', '.join(LAYOUTS)}")
     if row_group_rows < 1:
@@ -140,7 +155,6 @@ def ingest(
         raise InputFileError("no AIS input files given; name at least one file")
     out_dir = Path(out_dir)
     entries = [item.entry for item in _dataset_inputs(out_dir)]
-    query = load_query(query_path) if query_path is not None else everything_query()
     ingest_params(query)
     sources = [inspect_source(Path(p)) for p in paths]
     known = {entry["sha256"]: entry for entry in entries}
@@ -547,6 +561,18 @@ def read_dataset_window(
     duplicates). ``dataset_dir`` may be a ``Dataset`` already opened, which saves checking
     its files again for every window. ``start`` and ``end`` are timezone-aware.
     """
+    return read_window_counted(dataset_dir, query, start, end, columns)[0]
+
+
+def read_window_counted(
+    dataset_dir: Path | Dataset,
+    query: Query,
+    start: datetime,
+    end: datetime,
+    columns: Sequence[str] | None = None,
+) -> tuple[pa.Table, pa.Table]:
+    """``read_dataset_window``, and the rows in the window and the query that were
+    dropped as exact duplicates (of rows of another input)."""
     dataset = dataset_dir if isinstance(dataset_dir, Dataset) else Dataset.open(dataset_dir)
     wanted = list(CANONICAL_COLUMNS if columns is None else columns)
     read = scan_columns(wanted, query) if dataset.duplicate_free else CANONICAL_COLUMNS
@@ -559,9 +585,10 @@ def read_dataset_window(
     table = pa.concat_tables(tables) if tables else schema.empty_table()
     order = pc.sort_indices(table, sort_keys=[("mmsi", "ascending"), ("timestamp", "ascending")])
     table = table.take(order)
+    dropped = table.slice(0, 0)
     if not dataset.duplicate_free:
-        table, _ = _drop_duplicates(table)
-    return table.select(wanted)
+        table, dropped = _drop_duplicates(table)
+    return table.select(wanted), dropped
 
 
 def dataset_time_range(dataset_dir: Path | Dataset) -> tuple[datetime, datetime]:

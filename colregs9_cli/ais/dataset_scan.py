@@ -237,10 +237,17 @@ class Dataset:
     def time_range(self) -> tuple[datetime, datetime] | None:
         """The first and last timestamps of the position rows, from the row groups'
         statistics (row groups of static reports left out); None without positions."""
+        spans = self.position_spans_ms()
+        if not spans:
+            return None
+        return _utc(min(s for s, _ in spans)), _utc(max(e for _, e in spans))
+
+    def position_spans_ms(self) -> list[tuple[int, int]]:
+        """The first and last timestamps (ms since the epoch) of each row group that holds
+        positions, from the statistics alone: where in time the dataset has data."""
         lat = CANONICAL_SCHEMA.get_field_index("lat_deg")
         stamp = CANONICAL_SCHEMA.get_field_index("timestamp")
-        first: datetime | None = None
-        last: datetime | None = None
+        spans = []
         for fragment in self.arrow.get_fragments():
             metadata = fragment.metadata
             for index in range(metadata.num_row_groups):
@@ -253,9 +260,12 @@ class Dataset:
                     raise InputFileError(
                         f"{fragment.path}: row group {index} has no timestamp statistics; {_REMEDY}"
                     )
-                first = stats.min if first is None else min(first, stats.min)
-                last = stats.max if last is None else max(last, stats.max)
-        return None if first is None or last is None else (first, last)
+                spans.append((utc_ms(stats.min), utc_ms(stats.max)))
+        return spans
+
+
+def _utc(milliseconds: int) -> datetime:
+    return datetime.fromtimestamp(milliseconds / 1000, UTC)
 
 
 def _hidden(relative: Path) -> bool:

@@ -109,7 +109,9 @@ __all__ = [
     "InputFile",
     "RowSink",
     "StreamedInput",
+    "canonical_frame",
     "load_ais",
+    "no_positions_error",
     "rows_in_query",
     "scan_columns",
     "stream_ais",
@@ -198,10 +200,8 @@ def load_ais(
             collected.extend(part)
             inputs.append(InputFile(source.path, part.sha256, part.layout, part.ledger.rows_read))
     positions, dimension_reports = collected.finish(ledger)
-    if positions.empty and ledger.rows_outside_query == 0:
-        raise InputFileError(_no_ais_message(inputs, ledger))
     if positions.empty:
-        raise NoDataError(_no_data_message(query, ledger))
+        raise no_positions_error(inputs, ledger, query)
     if columns is not None:
         positions = positions[wanted]
     return AisData(positions, dimension_reports, ledger, tuple(inputs), len(positions))
@@ -315,6 +315,16 @@ def _dataset_reports(dataset: Dataset, vessels: np.ndarray) -> pa.Table:
             parts = [_sum_counts(parts)]
     empty = np.empty(0)
     return _sum_counts([_report_rows(empty, empty, empty, empty), *parts])
+
+
+def no_positions_error(
+    inputs: Sequence[InputFile], ledger: RejectsLedger, query: Query
+) -> InputFileError | NoDataError:
+    """The error for a read that left no position: the inputs hold none (exit 2), or
+    the query selects none of them (exit 3)."""
+    if ledger.rows_outside_query == 0:
+        return InputFileError(_no_ais_message(inputs, ledger))
+    return NoDataError(_no_data_message(query, ledger))
 
 
 def _no_ais_message(inputs: Sequence[InputFile], ledger: RejectsLedger) -> str:
@@ -1061,7 +1071,7 @@ class _Collected:
     def finish(self, ledger: RejectsLedger) -> tuple[pd.DataFrame, pd.DataFrame]:
         """Sort, drop exact duplicates (ledger), and count the used rows."""
         table = pa.concat_tables(self.kept) if self.kept else CANONICAL_SCHEMA.empty_table()
-        positions = _to_pandas(table)
+        positions = canonical_frame(table)
         positions = positions.sort_values(["mmsi", "timestamp"], kind="stable", ignore_index=True)
         if self.may_repeat:
             duplicate = positions.duplicated(keep="first").to_numpy()
@@ -1104,7 +1114,7 @@ def _subtract_counts(counts: pa.Table, dropped: pd.DataFrame) -> pa.Table:
     return _sum_counts([counts, removed])
 
 
-def _to_pandas(table: pa.Table) -> pd.DataFrame:
+def canonical_frame(table: pa.Table) -> pd.DataFrame:
     """Canonical columns (those of ``table``, in canonical order): int64 MMSI, nullable
     Int8/Int64 for status and IMO, NaN floats."""
     frame = table.to_pandas()
