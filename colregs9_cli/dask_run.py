@@ -24,7 +24,7 @@ from .geo import LocalFrame
 from .progress import ProgressSink
 from .replay_results import EncounterOutcome
 from .report.replay_report import Drawer, draw_encounter
-from .slabs import PairEvaluator, SlabContext, SlabResult, replay_slab
+from .slabs import PairEvaluator, SlabContext, SlabResult, replay_slab, slab_label
 
 # How long to wait for a scheduler given with --scheduler before giving up.
 _CONNECT_TIMEOUT_S = 10
@@ -79,6 +79,7 @@ def dask_slabs(
     for future in as_completed(futures):
         results.append(future.result())
         bar.advance()
+        bar.describe("done: " + slab_label(results[-1].slab, context.params.slab_s))
     return sorted(results, key=lambda result: result.slab)
 
 

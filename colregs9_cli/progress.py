@@ -14,19 +14,32 @@ if TYPE_CHECKING:
 class ProgressSink(Protocol):
     def advance(self, amount: float = 1.0) -> None: ...
 
+    def describe(self, note: str) -> None:
+        """Show ``note`` (what is in progress: a slab, a day) beside the description."""
+
 
 class _Silent:
     def advance(self, amount: float = 1.0) -> None:
         return None
 
+    def describe(self, note: str) -> None:
+        return None
+
 
 class _RichSink:
-    def __init__(self, progress: Progress, task_id: int) -> None:
+    def __init__(self, progress: Progress, task_id: int, description: str) -> None:
         self._progress = progress
         self._task_id = task_id
+        self._description = description
 
     def advance(self, amount: float = 1.0) -> None:
         self._progress.advance(self._task_id, amount)  # type: ignore[arg-type]
+
+    def describe(self, note: str) -> None:
+        self._progress.update(
+            self._task_id,  # type: ignore[arg-type]
+            description=f"{self._description} ({note})",
+        )
 
 
 def progress_enabled(quiet: bool) -> bool:
@@ -34,8 +47,11 @@ def progress_enabled(quiet: bool) -> bool:
 
 
 @contextmanager
-def progress_bar(description: str, total: float | None, enabled: bool) -> Iterator[ProgressSink]:
-    """A progress bar over ``total`` units (bytes, steps, ...), or a silent sink."""
+def progress_bar(
+    description: str, total: float | None, enabled: bool, in_bytes: bool = False
+) -> Iterator[ProgressSink]:
+    """A progress bar over ``total`` units (steps, slabs, ...; bytes, shown in MB, when
+    ``in_bytes``), or a silent sink."""
     if not enabled:
         yield _Silent()
         return
@@ -43,6 +59,7 @@ def progress_bar(description: str, total: float | None, enabled: bool) -> Iterat
     from rich.console import Console
     from rich.progress import (
         BarColumn,
+        DownloadColumn,
         MofNCompleteColumn,
         Progress,
         TextColumn,
@@ -53,7 +70,7 @@ def progress_bar(description: str, total: float | None, enabled: bool) -> Iterat
     progress = Progress(
         TextColumn("{task.description}"),
         BarColumn(),
-        MofNCompleteColumn(),
+        DownloadColumn() if in_bytes else MofNCompleteColumn(),
         TimeElapsedColumn(),
         TimeRemainingColumn(),
         console=Console(stderr=True),
@@ -61,4 +78,4 @@ def progress_bar(description: str, total: float | None, enabled: bool) -> Iterat
     )
     with progress:
         task_id = progress.add_task(description, total=total)
-        yield _RichSink(progress, task_id)
+        yield _RichSink(progress, task_id, description)

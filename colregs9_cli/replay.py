@@ -1,10 +1,10 @@
 """``colregs9 replay``: historical AIS, pair by pair, through G_a and G_d (DESIGN §5).
 
 The pipeline, slab by slab in time (``replay_input.py`` reads the AIS through the query one
-slab at a time, ``slabs.py`` segments and evaluates them): the run's local frame (the query's region, or
-the extent of the data when the query has none) → per-vessel tracks (``tracks.py``; reports
-dropped as same-second duplicates or speed jumps go into the rejects ledger) → encounters
-(``encounters.py``) → for each triggered pair, evaluated once for both seats:
+slab at a time, ``slabs.py`` segments and evaluates them): the run's local frame (the
+query's region, or the extent of the data when the query has none) → per-vessel tracks
+(``tracks.py``; reports dropped as same-second duplicates or speed jumps go into the rejects
+ledger) → encounters (``encounters.py``) → for each triggered pair, evaluated once for both seats:
 
 - **G_a** (``colregs.py``) classifies the pair at the trigger. That situation and both roles
   are held until the pair is past (rule 13(d)); the time series also records the
@@ -864,7 +864,7 @@ def run_replay(
             ais = open_replay_input(
                 ais_paths, query, fmt, quiet, Path(scratch), slab_s, REPLAY_COLUMNS
             )
-            with progress_bar("tracks (slabs)", len(ais.slabs), progress_enabled(quiet)) as bar:
+            with progress_bar("Tracks (slabs)", len(ais.slabs), progress_enabled(quiet)) as bar:
                 segmentation = segment_slabs(ais.positions(), spill_dir, params.replay, bar)
             ais.check_positions()
             if len(ais.vessels) < 2:
@@ -882,7 +882,9 @@ def run_replay(
             context = slab_context(segmentation, frame, params)
             slabs = slab_range(segmentation, params.replay)
             evaluate = functools.partial(_evaluate, params=params)
-            with progress_bar("pairs (slabs)", len(slabs), progress_enabled(quiet)) as bar:
+            with progress_bar(
+                "Pairs and verdicts (slabs)", len(slabs), progress_enabled(quiet)
+            ) as bar:
                 if cluster is None:
                     results = run_slabs(slabs, context, evaluate, chart, bar)
                 else:
@@ -925,7 +927,7 @@ def run_replay(
         )
         files: tuple[Path, ...] = ()
         if write:
-            with progress_bar("reports", len(result.encounters), progress_enabled(quiet)) as bar:
+            with progress_bar("Reports", len(result.encounters), progress_enabled(quiet)) as bar:
                 if cluster is None:
                     files = write_replay_reports(result, chart, plots, bar)
                 else:

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -176,6 +177,12 @@ def slabs_of_frame(positions: pd.DataFrame, slab_s: float) -> Iterator[tuple[int
         yield int(index), part  # type: ignore[call-overload]
 
 
+def slab_label(index: int, slab_s: float) -> str:
+    """The slab's start in UTC, for progress bars."""
+    start = datetime.fromtimestamp(index * slab_s, UTC)
+    return start.strftime("%Y-%m-%d %H:%M:%S UTC")
+
+
 def segment_slabs(
     slabs: Iterable[tuple[int, pd.DataFrame]],
     spill_dir: Path,
@@ -216,6 +223,7 @@ def segment_slabs(
             first_s, last_s = min(first_s, float(t.min())), max(last_s, float(t.max()))
             vessels.update(np.unique(kept["mmsi"].to_numpy()).tolist())
         bar.advance()
+        bar.describe(slab_label(index, params.slab_s))
         current = following
     return Segmentation(
         spill=Spill(tuple(files)),
@@ -402,6 +410,7 @@ def run_slabs(
     """Stage 2 over ``slabs`` in this process, in slab order."""
     results = []
     for slab in slabs:
+        bar.describe(slab_label(slab, context.params.slab_s))
         results.append(replay_slab(slab, context, evaluate, chart))
         bar.advance()
     return results

@@ -49,6 +49,10 @@ class _LateProgress:
                 return
         self._bar.advance(amount)
 
+    def describe(self, note: str) -> None:
+        if self._bar is not None:
+            self._bar.describe(note)
+
     def attach(self, bar: ProgressSink) -> None:
         with self._lock:
             self._bar = bar

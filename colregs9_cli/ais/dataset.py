@@ -167,7 +167,7 @@ def ingest_with_query(
             raise _output_error(out_dir, exc) from None
     results = []
     total = float(sum(s.size_bytes for s in new.values()))
-    with progress_bar("Reading AIS (bytes)", total, progress_enabled(quiet)) as bar:
+    with progress_bar("Reading AIS", total, progress_enabled(quiet), in_bytes=True) as bar:
         for source, sha256 in zip(sources, hashes, strict=True):
             if sha256 in known:
                 results.append(_already(source.path, known[sha256]))

@@ -190,7 +190,7 @@ def load_ais(
     scanned = scan_columns(wanted, query) if not collected.may_repeat else CANONICAL_COLUMNS
     inputs: list[InputFile] = []
     total_bytes = float(sum(s.size_bytes for s in sources))
-    with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet)) as bar:
+    with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet), in_bytes=True) as bar:
         for index, source in enumerate(sources):
             if not isinstance(source, Source):
                 inputs.extend(_read_dataset(source, query, scanned, ledger, collected, bar))

@@ -179,6 +179,9 @@ class _Silent:
     def advance(self, amount: float = 1.0) -> None:
         return None
 
+    def describe(self, note: str) -> None:
+        return None
+
 
 def read_head(source: Source, n_bytes: int = HEAD_BYTES) -> bytes:
     """The first ``n_bytes`` of the decompressed data."""
