@@ -327,20 +327,27 @@ def replay_slab(
     tracks = _tracks(job, window, None)
     own = job.own_mmsi or None
     search = find_encounters(tracks, params, own, counted_steps=core, require_own=False)
-    owned: list[tuple[Encounter, Tracks]] = []
-    followed: dict[tuple[int, ...], tuple[Encounter, Tracks]] = {}
+    # Seats of encounters still going on at the window's end are followed, all together.
+    PairKey = tuple[int, int, int]
+    slots: list[tuple[Encounter, Tracks] | tuple[PairKey, tuple[int, int]]] = []
+    to_follow: dict[PairKey, Encounter] = {}
     for encounter in search.encounters:
         if not core[0] <= encounter.start_step <= core[1]:
             continue
         if _whole(encounter, window[1], params) or window[1] > last_data_step:
-            owned.append((encounter, tracks))
+            slots.append((encounter, tracks))
             continue
-        pair = (encounter.start_step, *sorted((encounter.own_mmsi, encounter.target_mmsi)))
-        if pair not in followed:
-            for longer in _follow(job, encounter, window):
-                key = (longer[0].own_mmsi, longer[0].target_mmsi)
-                followed[(*pair, *key)] = longer
-        owned.append(followed[(*pair, encounter.own_mmsi, encounter.target_mmsi)])
+        a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
+        key = (encounter.start_step, a, b)
+        to_follow.setdefault(key, encounter)
+        slots.append((key, (encounter.own_mmsi, encounter.target_mmsi)))
+    followed = _follow(job, to_follow, window)
+    owned: list[tuple[Encounter, Tracks]] = []
+    for first, second in slots:
+        if isinstance(first, Encounter):
+            owned.append((first, second))  # type: ignore[arg-type]
+        else:
+            owned.append(followed[first][second])  # type: ignore[index]
     encounters = tuple(e for e, _ in owned)
     by_id = {e.encounter_id: t for e, t in owned}
     pairs = []
@@ -361,28 +368,43 @@ def replay_slab(
                 & (tracks.samples["sog_kn"] >= params.min_sog_kn)
             ).sum()
         ),
-        followed=len({key[:3] for key in followed}),
+        followed=len(to_follow),
     )
 
 
 def _follow(
-    job: SlabContext, encounter: Encounter, window: tuple[int, int]
-) -> list[tuple[Encounter, Tracks]]:
-    """The encounter as far as it goes, in each of its seats: its two vessels alone, in
-    windows that double."""
+    job: SlabContext,
+    encounters: dict[tuple[int, int, int], Encounter],
+    window: tuple[int, int],
+) -> dict[tuple[int, int, int], dict[tuple[int, int], tuple[Encounter, Tracks]]]:
+    """Each encounter (keyed by its start step and sorted MMSIs) as far as it goes, in each
+    of its seats: its vessels' samples in windows that double, until every seat is whole.
+    The pairs are followed together (one read and one search per window); an encounter is
+    a matter of its two vessels alone, so the others do not change it."""
     params = job.params
-    pair = (encounter.own_mmsi, encounter.target_mmsi)
-    own = [m for m in job.own_mmsi if m in pair] if job.own_mmsi else None
     last_data_step = math.floor(job.data_end_s / params.step_s)
     reach = window[1] - window[0]
-    while True:
+    pending = dict(encounters)
+    found: dict[tuple[int, int, int], dict[tuple[int, int], tuple[Encounter, Tracks]]] = {}
+    while pending:
         reach *= 2
         steps = (window[0], window[0] + reach)
-        tracks = _tracks(job, steps, pair)
+        vessels = sorted({m for _, a, b in pending for m in (a, b)})
+        own = [m for m in job.own_mmsi if m in vessels] if job.own_mmsi else None
+        tracks = _tracks(job, steps, vessels)
         search = find_encounters(tracks, params, own, require_own=False)
-        seats = [e for e in search.encounters if e.start_step == encounter.start_step]
-        if all(_whole(e, steps[1], params) for e in seats) or steps[1] > last_data_step:
-            return [(e, tracks) for e in seats]
+        seats: dict[tuple[int, int, int], list[Encounter]] = {}
+        for encounter in search.encounters:
+            a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
+            key = (encounter.start_step, a, b)
+            if key in pending:
+                seats.setdefault(key, []).append(encounter)
+        for key in list(pending):
+            mine = seats.get(key, [])
+            if all(_whole(e, steps[1], params) for e in mine) or steps[1] > last_data_step:
+                found[key] = {(e.own_mmsi, e.target_mmsi): (e, tracks) for e in mine}
+                del pending[key]
+    return found
 
 
 def triggered_pairs(

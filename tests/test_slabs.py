@@ -70,10 +70,19 @@ def test_sandiego_with_a_chart_is_the_same_in_slabs() -> None:
     _same(_replay([SANDIEGO_AIS], [SANDIEGO_ENC], slab_s=600.0), expected)
 
 
-def _converging(path: Path) -> Path:
+def _converging(path: Path, pairs: int = 1) -> Path:
     """Two vessels an hour long, A east at 10 kn, B 1 km south of her on 085° at 10 kn: a
     candidate pair from the first report, which closes at 0.45 m/s and triggers about 35
-    minutes later."""
+    minutes later. ``pairs`` such pairs, 0.2° of latitude apart."""
+    rows = [
+        (stamp, mmsi + 2 * k, lat + 0.2 * k, lon, sog, cog)
+        for k in range(pairs)
+        for stamp, mmsi, lat, lon, sog, cog in _converging_rows()
+    ]
+    return write_dma(path, rows)
+
+
+def _converging_rows() -> list[tuple]:
     rows = []
     metres_per_deg_lon = 111_320 * np.cos(np.radians(57.0))
     speed_mps = 10 * 1852 / 3600
@@ -94,7 +103,7 @@ def _converging(path: Path) -> Path:
                 85.0,
             )
         )
-    return write_dma(path, rows)
+    return rows
 
 
 def test_an_encounter_longer_than_a_slab_window_is_followed(tmp_path: Path) -> None:
@@ -106,6 +115,22 @@ def test_an_encounter_longer_than_a_slab_window_is_followed(tmp_path: Path) -> N
     assert expected.manifest["slabs"]["pairs_followed_past_their_slab"] == 0
     in_slabs = _replay([path], slab_s=300.0)
     assert in_slabs.manifest["slabs"]["pairs_followed_past_their_slab"] == 1
+    _same(in_slabs, expected)
+
+
+@pytest.mark.parametrize("own_mmsi", [(), (219000003,)])
+def test_encounters_followed_together_are_those_followed_alone(tmp_path: Path, own_mmsi) -> None:
+    """Three such pairs followed in one read and search per window: each as in one slab."""
+    path = _converging(tmp_path / "three.csv", pairs=3)
+
+    def replay(slab_s: float | None):
+        overrides = ONE_SLAB if slab_s is None else {"replay": {"slab_s": slab_s}}
+        return run_replay([path], own_mmsi=own_mmsi, overrides=overrides, write=False)
+
+    expected = replay(None)
+    assert len(expected.pairs) == (1 if own_mmsi else 3)
+    in_slabs = replay(300.0)
+    assert in_slabs.manifest["slabs"]["pairs_followed_past_their_slab"] == (1 if own_mmsi else 3)
     _same(in_slabs, expected)
 
 
