@@ -300,39 +300,56 @@ def _batch_runs(
     a, b = a[order], b[order]
     rel_velocity = velocity[b] - velocity[a]
     range_m, cpa_m, tcpa_s = cpa_tcpa_vectors(position[b] - position[a], rel_velocity)
-    frame = pd.DataFrame(
-        {
-            "vessel_a": vessel[a],
-            "vessel_b": vessel[b],
-            "step": step[a],
-            "range_m": range_m,
-            "cpa_m": cpa_m,
-            "tcpa_s": tcpa_s,
-        }
-    )
     rel_speed_mps = np.linalg.norm(rel_velocity, axis=-1)
     fires = trigger_mask(cpa_m, tcpa_s, rel_speed_mps, params)
-    return _runs(frame, pd.Series(fires, index=frame.index))
+    return _runs(vessel[a], vessel[b], step[a], range_m, cpa_m, tcpa_s, fires)
 
 
-def _runs(frame: pd.DataFrame, fires: pd.Series) -> pd.DataFrame:
-    """Collapse rows sorted by (vessel_a, vessel_b, step) into runs of consecutive steps."""
-    same_pair = (frame["vessel_a"].diff() == 0) & (frame["vessel_b"].diff() == 0)
-    run = (~(same_pair & (frame["step"].diff() == 1))).cumsum()
-    fired = frame[fires.to_numpy()]
-    grouped = frame.groupby(run.to_numpy(), sort=True)
-    summary = grouped.agg(
-        vessel_a=("vessel_a", "first"),
-        vessel_b=("vessel_b", "first"),
-        start_step=("step", "min"),
-        end_step=("step", "max"),
-        min_range_m=("range_m", "min"),
+def _runs(
+    vessel_a: NDArray[np.intp],
+    vessel_b: NDArray[np.intp],
+    step: NDArray[np.int64],
+    range_m: NDArray[np.float64],
+    cpa_m: NDArray[np.float64],
+    tcpa_s: NDArray[np.float64],
+    fires: NDArray[np.bool_],
+) -> pd.DataFrame:
+    """Collapse rows sorted by (vessel_a, vessel_b, step) into runs of consecutive steps,
+    each with its first firing step (the trigger)."""
+    new_run = np.ones(len(step), dtype=bool)
+    new_run[1:] = (
+        (vessel_a[1:] != vessel_a[:-1])
+        | (vessel_b[1:] != vessel_b[:-1])
+        | (step[1:] != step[:-1] + 1)
     )
-    trigger = fired.groupby(run.to_numpy()[fires.to_numpy()], sort=True).first()
-    summary["trigger_step"] = trigger["step"].reindex(summary.index).astype("Int64")
-    for name in ("range_m", "cpa_m", "tcpa_s"):
-        summary[f"{name}_at_trigger"] = trigger[name].reindex(summary.index)
-    return summary.reset_index(drop=True)
+    starts = np.flatnonzero(new_run)
+    ends = np.r_[starts[1:], len(step)][: len(starts)] - 1
+    run = np.cumsum(new_run) - 1
+    fired = np.flatnonzero(fires)
+    fired_runs, first = np.unique(run[fired], return_index=True)
+    trigger_row = np.zeros(len(starts), dtype=np.intp)
+    trigger_row[fired_runs] = fired[first]
+    triggered = np.zeros(len(starts), dtype=bool)
+    triggered[fired_runs] = True
+    trigger_step = pd.array(step[trigger_row], dtype="Int64")
+    trigger_step[~triggered] = pd.NA
+
+    def at_trigger(values: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.where(triggered, values[trigger_row], np.nan)
+
+    return pd.DataFrame(
+        {
+            "vessel_a": vessel_a[starts],
+            "vessel_b": vessel_b[starts],
+            "start_step": step[starts],
+            "end_step": step[ends],
+            "min_range_m": np.minimum.reduceat(range_m, starts) if len(starts) else range_m,
+            "trigger_step": trigger_step,
+            "range_m_at_trigger": at_trigger(range_m),
+            "cpa_m_at_trigger": at_trigger(cpa_m),
+            "tcpa_s_at_trigger": at_trigger(tcpa_s),
+        }
+    )
 
 
 def _join_runs(runs: list[pd.DataFrame]) -> pd.DataFrame:
