@@ -188,21 +188,28 @@ def candidate_pairs_nd(
     strides = [int(np.prod(sizes[i + 1 :], dtype=np.int64)) for i in range(len(sizes))]
     order = np.argsort(key, kind="stable")
     sorted_key = key[order]
+    # The occupied cells, each a run of sorted points: neighbours are looked up per cell.
+    cell_keys, cell_first, cell_count = np.unique(sorted_key, return_index=True, return_counts=True)
+    point_cell = np.repeat(np.arange(len(cell_keys)), cell_count)
+    points = np.arange(len(sorted_key))
     firsts: list[NDArray[np.intp]] = []
     seconds: list[NDArray[np.intp]] = []
     for offset in itertools.product((-1, 0, 1), repeat=len(cells)):
         if offset < (0,) * len(cells):
             continue  # the mirrored neighbour finds this pair
-        wanted = sorted_key + sum(o * stride for o, stride in zip(offset, strides, strict=True))
-        lo = np.searchsorted(sorted_key, wanted, side="left")
-        hi = np.searchsorted(sorted_key, wanted, side="right")
         if not any(offset):
-            lo = np.arange(len(sorted_key)) + 1  # the same cell: only later points
-        counts = np.maximum(hi - lo, 0)
+            lo = points + 1  # the same cell: only later points
+            counts = (cell_first + cell_count)[point_cell] - lo
+        else:
+            wanted = cell_keys + sum(o * stride for o, stride in zip(offset, strides, strict=True))
+            found_at = np.minimum(np.searchsorted(cell_keys, wanted), len(cell_keys) - 1)
+            found = cell_keys[found_at] == wanted
+            lo = np.where(found, cell_first[found_at], 0)[point_cell]
+            counts = np.where(found, cell_count[found_at], 0)[point_cell]
         total = int(counts.sum())
         if total == 0:
             continue
-        position = np.repeat(np.arange(len(sorted_key)), counts)
+        position = np.repeat(points, counts)
         start = np.cumsum(counts) - counts
         partner = lo[position] + (np.arange(total) - start[position])
         firsts.append(order[position])
