@@ -199,13 +199,12 @@ def parse_cut_rows(
 
 def _gather(data: memoryview, starts: NDArray[np.int64], stops: NDArray[np.int64]) -> memoryview:
     """The byte ranges ``[start, stop)`` of ``data`` one after another."""
-    lengths = stops - starts
-    # The index of every byte to copy: each range's first byte, then steps of one.
-    steps = np.ones(int(lengths.sum()), np.int64)
-    firsts = np.cumsum(lengths[:-1])
-    steps[0:1] = starts[:1]
-    steps[firsts] = starts[1:] - stops[:-1] + 1
-    return memoryview(np.frombuffer(data, np.uint8)[np.cumsum(steps)].tobytes())
+    # Adjacent ranges (runs of consecutive lines) are copied as one.
+    joined = np.r_[False, starts[1:] == stops[:-1]]
+    firsts = np.flatnonzero(~joined)
+    run_starts = starts[firsts].tolist()
+    run_stops = stops[np.r_[firsts[1:] - 1, len(stops) - 1]].tolist() if len(firsts) else []
+    return memoryview(b"".join(data[a:b] for a, b in zip(run_starts, run_stops, strict=True)))
 
 
 @dataclass(frozen=True)
