@@ -190,7 +190,8 @@ def summarise(samples: pd.DataFrame, group: str | None = None) -> StatsTable:
     """The statistics of each dimension over the rows of ``samples`` (one row per unit)."""
     rows = []
     for dimension in DIMENSIONS:
-        values = samples[dimension].dropna().to_numpy(dtype=float)
+        # Sorted, so that the sums (mean, std) do not depend on the order of the rows.
+        values = np.sort(samples[dimension].dropna().to_numpy(dtype=float))
         count = int(values.size)
         rows.append(
             DimensionStats(

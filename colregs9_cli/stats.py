@@ -77,7 +77,13 @@ def run_stats(
         per = _choice(Per, per, "--per")
         by = None if by is None else _choice(GroupBy, by, "--by")
         data = load_ais(
-            paths, query=query, fmt=fmt, quiet=quiet, started=started, columns=POSITION_COLUMNS
+            paths,
+            query=query,
+            fmt=fmt,
+            quiet=quiet,
+            started=started,
+            columns=POSITION_COLUMNS,
+            ordered=False,
         )
     result = dimension_stats(data.positions, data.dimension_reports, per=per, by=by)
     manifest = build_manifest(result, query, data)

@@ -163,6 +163,7 @@ def load_ais(
     quiet: bool = True,
     started: CsvReading | None = None,
     columns: Sequence[str] | None = None,
+    ordered: bool = True,
 ) -> AisData:
     """Read AIS files (any mix of layouts) through ``query`` into cleaned positions.
 
@@ -171,7 +172,9 @@ def load_ais(
     ``colregs9 ingest`` (``_read_dataset``; ``fmt`` does not apply to it). ``started``: the
     first file, already being read (``csv_read.start_reading``). ``columns``: the columns
     of ``positions`` (default: all, ``CANONICAL_COLUMNS``); a dataset read alone decodes
-    only these and those the query tests (``_dataset_alone``). Raises ``InputFileError``
+    only these and those the query tests (``_dataset_alone``). ``ordered``: the positions
+    sorted by MMSI and time; a caller that needs no order (``stats``) saves the sort of a
+    dataset read alone. Raises ``InputFileError``
     for unreadable files, ``NoDataError`` (exit code 3) when no position row is left in the
     query.
     """
@@ -186,8 +189,10 @@ def load_ais(
         raise ParameterError(f"columns {wanted}: give canonical columns ({CANONICAL_COLUMNS})")
     sources = [_open_input(Path(p)) for p in paths]
     ledger = RejectsLedger()
-    collected = _Collected(may_repeat=not _dataset_alone(sources))
-    scanned = scan_columns(wanted, query) if not collected.may_repeat else CANONICAL_COLUMNS
+    collected = _Collected(may_repeat=not _dataset_alone(sources), ordered=ordered)
+    scanned = (
+        scan_columns(wanted, query, ordered) if not collected.may_repeat else CANONICAL_COLUMNS
+    )
     inputs: list[InputFile] = []
     total_bytes = float(sum(s.size_bytes for s in sources))
     with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet), in_bytes=True) as bar:
@@ -234,10 +239,12 @@ def _dataset_alone(sources: Sequence[Source | Dataset]) -> bool:
     return len(sources) == 1 and not isinstance(sources[0], Source) and sources[0].duplicate_free
 
 
-def scan_columns(wanted: Sequence[str], query: Query) -> tuple[str, ...]:
+def scan_columns(wanted: Sequence[str], query: Query, ordered: bool = True) -> tuple[str, ...]:
     """The columns to read for ``wanted`` columns of the positions in ``query``: also those
-    the query tests, and the sort keys (mmsi, timestamp)."""
-    needed = {*wanted, "mmsi", "timestamp"}
+    the query tests, and the sort keys (mmsi, timestamp) when the rows are to be ``ordered``."""
+    needed = {*wanted, "mmsi"}
+    if ordered or not query.time.unbounded:
+        needed.add("timestamp")
     if query.region is not None:
         needed |= {"lat_deg", "lon_deg"}
     if not query.vessels.selects_all:
@@ -1062,6 +1069,7 @@ class _Collected:
     datasets: list[Dataset] = field(default_factory=list)
     # False when the rows cannot hold exact duplicates (``_dataset_alone``): none are sought.
     may_repeat: bool = True
+    ordered: bool = True
 
     def extend(self, part: _FileResult) -> None:
         self.kept.extend(part.kept)
@@ -1072,7 +1080,10 @@ class _Collected:
         """Sort, drop exact duplicates (ledger), and count the used rows."""
         table = pa.concat_tables(self.kept) if self.kept else CANONICAL_SCHEMA.empty_table()
         positions = canonical_frame(table)
-        positions = positions.sort_values(["mmsi", "timestamp"], kind="stable", ignore_index=True)
+        if self.ordered or self.may_repeat:
+            positions = positions.sort_values(
+                ["mmsi", "timestamp"], kind="stable", ignore_index=True
+            )
         if self.may_repeat:
             duplicate = positions.duplicated(keep="first").to_numpy()
         else:
@@ -1119,7 +1130,8 @@ def canonical_frame(table: pa.Table) -> pd.DataFrame:
     Int8/Int64 for status and IMO, NaN floats."""
     frame = table.to_pandas()
     frame["mmsi"] = frame["mmsi"].astype(np.int64)
-    frame["timestamp"] = pd.to_datetime(frame["timestamp"], utc=True)
+    if "timestamp" in frame.columns:
+        frame["timestamp"] = pd.to_datetime(frame["timestamp"], utc=True)
     for name, dtype in (("nav_status", "Int8"), ("imo", "Int64")):
         if name in frame.columns:
             frame[name] = frame[name].astype(dtype)
