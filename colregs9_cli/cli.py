@@ -61,7 +61,7 @@ def replay_command(
     ais: Annotated[
         list[Path],
         typer.Argument(
-            metavar="AIS...",
+            metavar="AIS",
             help="AIS files: DMA CSV (22/26 columns), MarineCadastre CSV or raw NMEA (.gz ok); "
             "or dataset directories made by colregs9 ingest.",
         ),
@@ -268,7 +268,7 @@ def stats_command(
     ais: Annotated[
         list[Path],
         typer.Argument(
-            metavar="AIS...",
+            metavar="AIS",
             help="AIS files: DMA CSV (22/26 columns, .gz/.zip ok), MarineCadastre CSV, raw "
             "NMEA or canonical Parquet; or dataset directories made by colregs9 ingest.",
         ),
@@ -349,7 +349,7 @@ def ingest_command(
     ais: Annotated[
         list[Path],
         typer.Argument(
-            metavar="AIS...",
+            metavar="AIS",
             help="AIS files: DMA CSV (22/26 columns, .gz/.zip ok), MarineCadastre CSV, raw "
             "NMEA or canonical Parquet.",
         ),
@@ -425,7 +425,7 @@ def chart_command(
     charts: Annotated[
         list[Path],
         typer.Argument(
-            metavar="CHART...",
+            metavar="CHART",
             help="Chart files (S-57 .000, GeoJSON, GeoPackage); several are merged.",
         ),
     ],
