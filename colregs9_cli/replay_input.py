@@ -35,7 +35,7 @@ from .ais.ledger import RejectReason, RejectsLedger
 from .ais.load import InputFile, canonical_frame, load_ais, no_positions_error
 from .errors import InputFileError
 from .query import Query
-from .slabs import slab_of
+from .slabs import slab_of, slabs_of_frame
 
 __all__ = ["ReplayInput", "open_replay_input"]
 
@@ -67,11 +67,10 @@ class ReplayInput:
         if self.in_memory is not None:
             frame = self.in_memory
             self.in_memory = None
-            slab = slab_of(frame["timestamp"], self.slab_s)
-            for index, part in frame.groupby(slab, sort=True):
+            for index, part in slabs_of_frame(frame, self.slab_s):
                 self.kept += len(part)
                 self.vessels.update(np.unique(part["mmsi"].to_numpy()).tolist())
-                yield int(index), part  # type: ignore[call-overload]
+                yield index, part
             return
         assert self.dataset is not None
         for index in self.slabs:
