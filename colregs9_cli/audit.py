@@ -10,15 +10,17 @@ before the closest approach the answer is ``insufficient-data``, never ``false``
   minimum separation is then the least range from the trigger to it.
 - **Conduct.** Up to the closest approach, a vessel *changed* when her course turned by at
   least ``course_change_deg`` from her first course that can be judged, or her speed changed
-  by at least ``speed_change_frac`` of her speed at the trigger. A course is judged only at
-  speeds of at least ``course_judged_above_kn``: below that COG is GPS noise. The first change
-  in time is her action (starboard turn, port turn, slowed, sped up). With no change, and her
-  course judged at fewer than half of the steps, the answer is ``insufficient-data``: a slow
-  vessel's turn cannot be seen in her COG.
+  by at least ``speed_change_frac`` of her speed at the trigger and by at least
+  ``speed_change_min_kn`` (a slow vessel's SOG noise is a large fraction of it). A course is
+  judged only at speeds of at least ``course_judged_above_kn``: below that COG is GPS noise.
+  The first change in time is her action (starboard turn, port turn, slowed, sped up). With
+  no change, and her course judged at fewer than half of the steps, the answer is
+  ``insufficient-data``: a slow vessel's turn cannot be seen in her COG.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import StrEnum
@@ -72,6 +74,7 @@ def passage(range_m: ArrayLike, tcpa_s: ArrayLike) -> Passage:
 class ConductParams:
     course_change_deg: float
     speed_change_frac: float
+    speed_change_min_kn: float
     course_judged_above_kn: float
 
 
@@ -100,11 +103,12 @@ def conduct(course_deg: ArrayLike, sog_kn: ArrayLike, params: ConductParams) -> 
         if len(turned):
             row = int(turned[0])
             events.append((row, Action.STARBOARD_TURN if change[row] > 0.0 else Action.PORT_TURN))
-    trigger_speed = sog[0] if len(sog) else np.nan
-    if np.isfinite(trigger_speed) and trigger_speed > 0.0:
+    trigger_speed = float(sog[0]) if len(sog) else math.nan
+    if math.isfinite(trigger_speed) and trigger_speed > 0.0:
+        least_kn = max(params.speed_change_frac * trigger_speed, params.speed_change_min_kn)
         with np.errstate(invalid="ignore"):
-            slowed = np.flatnonzero(sog <= (1.0 - params.speed_change_frac) * trigger_speed)
-            sped_up = np.flatnonzero(sog >= (1.0 + params.speed_change_frac) * trigger_speed)
+            slowed = np.flatnonzero(sog <= trigger_speed - least_kn)
+            sped_up = np.flatnonzero(sog >= trigger_speed + least_kn)
         if len(slowed):
             events.append((int(slowed[0]), Action.SLOWED))
         if len(sped_up):

@@ -24,16 +24,19 @@ seats swaps the roles and nothing else. In order of precedence:
    is the one a small course error would flip. An exact tie (reciprocal courses, equal
    bearings) is the rule 14(c) doubt again: head-on.
 
-A situation is ``ambiguous`` when moving either bearing by ``ambiguity_margin_deg`` would
-change it or either role: it lies near a sector boundary, where the course noise of AIS can
-decide. ``SituationBasis`` records whether it rests on the sectors alone, on rule 14(c) or on
-the same-side reading of rule 15. The replay fixes the situation at
-the trigger and holds it until the pair is past (rule 13(d)); ``classify`` itself has no
-memory and also gives the instantaneous geometry of every step.
+A situation is ``ambiguous`` when moving either bearing by ``ambiguity_margin_deg`` would change
+it or either role: it lies near a sector boundary, where the course noise of AIS can decide.
+``evaluate_colregs`` also flags a step where either vessel's course is a COG below the speed at
+which COG is judged (``[replay] course_judged_above_kn``): her bearings are noise.
+``SituationBasis`` records whether it rests on the sectors alone, on rule 14(c) or on the
+same-side reading of rule 15. The replay fixes the situation at the trigger and holds it until
+the pair is past (rule 13(d)); ``classify`` itself has no memory and also gives the
+instantaneous geometry of every step.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from dataclasses import dataclass
@@ -49,7 +52,7 @@ from .encounters import velocity_mps
 from .errors import ParameterError
 from .geo import course_in_tangent_plane
 from .replay_params import CourseSource
-from .units import wrap_deg
+from .units import MPS_PER_KNOT, wrap_deg
 
 
 class Situation(StrEnum):
@@ -177,6 +180,16 @@ class Kinematics:
         )
         return own, target
 
+    def course_from_noisy_cog(
+        self, source: CourseSource, course_judged_above_kn: float
+    ) -> NDArray[np.bool_]:
+        """Where the course used is COG at a speed below ``course_judged_above_kn``."""
+        speed_kn = np.asarray(self.speed_mps, dtype=float) / MPS_PER_KNOT
+        from_cog = np.ones(np.shape(speed_kn), dtype=bool)
+        if source is CourseSource.HEADING:
+            from_cog = np.isnan(np.asarray(self.heading_deg, dtype=float))
+        return np.atleast_1d(from_cog & (speed_kn < course_judged_above_kn))
+
     def course_deg(self, source: CourseSource) -> NDArray[np.float64]:
         cog = np.asarray(self.cog_deg, dtype=float)
         if source is CourseSource.COG:
@@ -215,9 +228,17 @@ def relative_bearing_deg(
 
 
 def evaluate_colregs(
-    own: Kinematics, target: Kinematics, params: ColregsParams
+    own: Kinematics,
+    target: Kinematics,
+    params: ColregsParams,
+    course_judged_above_kn: float = 0.0,
 ) -> ColregsEvaluation:
-    """G_a: situation and roles for each step of own ship and target (see module docstring)."""
+    """G_a: situation and roles for each step of own ship and target (see module docstring).
+
+    A step where either vessel's course is her COG and she is slower than
+    ``course_judged_above_kn`` is ambiguous too: her COG is GPS noise there, so the bearings
+    that decide the sectors are.
+    """
     beta = relative_bearing_deg(
         own.north_m, own.east_m, own.course_deg(params.course_source), target.north_m, target.east_m
     )
@@ -233,7 +254,13 @@ def evaluate_colregs(
     rel_n = np.asarray(target.north_m, dtype=float) - np.asarray(own.north_m, dtype=float)
     rel_e = np.asarray(target.east_m, dtype=float) - np.asarray(own.east_m, dtype=float)
     closing = (rel_n * (tgt_vn - own_vn) + rel_e * (tgt_ve - own_ve)) < 0.0
-    return classify(beta, beta_prime, closing, params)
+    result = classify(beta, beta_prime, closing, params)
+    noisy_course = own.course_from_noisy_cog(
+        params.course_source, course_judged_above_kn
+    ) | target.course_from_noisy_cog(params.course_source, course_judged_above_kn)
+    return dataclasses.replace(
+        result, ambiguous=result.ambiguous | (noisy_course & (result.situation != Situation.NONE))
+    )
 
 
 @dataclass(frozen=True)

@@ -282,7 +282,11 @@ def _pair_steps(
     step_s: float,
 ) -> _PairSteps:
     """G_a, the estimates and G_d of both seats at every step of ``series`` (a = own_)."""
-    g_a = evaluate_colregs(*Kinematics.pair_from_series(series), params.colregs)
+    g_a = evaluate_colregs(
+        *Kinematics.pair_from_series(series),
+        params.colregs,
+        course_judged_above_kn=params.replay.course_judged_above_kn,
+    )
     rows = len(series)
     held = ColregsEvaluation(
         **{
@@ -336,21 +340,38 @@ def _pair_steps(
     )
 
 
-def _rests_on_defaults(
+def rests_on_defaults(
     verdict: PairVerdict,
-    dimensions: tuple[VesselDimensions, ...],
+    dimensions: tuple[VesselDimensions, VesselDimensions],
     estimates: tuple[Restriction, Restriction],
+    nav_status: tuple[int | None, int | None],
+    restricted_nav_statuses: frozenset[int],
 ) -> bool:
-    """True when the estimator's answer for a vessel with defaulted dimensions decided: as
-    G_d's d3 about her (the give-way vessel), or as her "restricted" that made both
-    restricted. "Unknown" (no chart) rests on no dimension."""
-    about = (verdict.seat_b, verdict.seat_a)
-    for seat, dims, estimate in zip(about, dimensions, estimates, strict=True):
-        answered = estimate is not Restriction.UNKNOWN and bool(dims.defaulted)
-        entered = seat.d3 is not Finding.NOT_EVALUATED or (
-            verdict.both_restricted and estimate is Restriction.RESTRICTED
+    """True when an estimate made from defaulted dimensions decided the verdict: the other
+    answer about that vessel would give other final roles or another deciding rule. This
+    covers G_d's d3 about the give-way vessel and the stand-on vessel's "clear" that let rule
+    9 choose between them. "Unknown" (off the chart) rests on no dimension."""
+    other_answer = {
+        Restriction.RESTRICTED: Restriction.NOT_RESTRICTED,
+        Restriction.NOT_RESTRICTED: Restriction.RESTRICTED,
+    }
+    for vessel in (0, 1):
+        estimate = estimates[vessel]
+        if estimate not in other_answer or not bool(dimensions[vessel].defaulted):
+            continue
+        changed = list(estimates)
+        changed[vessel] = other_answer[estimate]
+        alternative = decide_pair(
+            verdict.situation,
+            verdict.role_colregs,
+            nav_status,
+            (changed[0], changed[1]),
+            restricted_nav_statuses,
         )
-        if answered and entered:
+        if (alternative.role_final, alternative.deciding_rule) != (
+            verdict.role_final,
+            verdict.deciding_rule,
+        ):
             return True
     return False
 
@@ -372,7 +393,10 @@ def _audit(window: pd.DataFrame, params: ReplayParams, step_s: float) -> _Audit:
         return _Audit(False, None, None, (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT), (None, None))
     until = window.iloc[: seen.cpa_row + 1]
     conduct_params = ConductParams(
-        params.course_change_deg, params.speed_change_frac, params.course_judged_above_kn
+        params.course_change_deg,
+        params.speed_change_frac,
+        params.speed_change_min_kn,
+        params.course_judged_above_kn,
     )
     conducts = tuple(
         conduct(
@@ -457,7 +481,14 @@ def evaluate_pair(
         )
         for i, (mmsi, prefix) in enumerate(((a, "own_"), (b, "target_")))
     )
-    pair_summary = _pair_summary(encounter, (vessels[0], vessels[1]), steps, audit, seats)
+    pair_summary = _pair_summary(
+        encounter,
+        (vessels[0], vessels[1]),
+        steps,
+        audit,
+        seats,
+        params.replay.restricted_nav_statuses,
+    )
     outcomes = []
     for own in sorted(set(seats)):
         flip = own == b
@@ -481,6 +512,7 @@ def _pair_summary(
     steps: _PairSteps,
     audit: _Audit,
     seats: Sequence[int],
+    restricted_nav_statuses: frozenset[int],
 ) -> PairSummary:
     verdict = steps.verdicts[0]
     trigger = steps.series.iloc[0]
@@ -514,10 +546,12 @@ def _pair_summary(
         role_final_a=verdict.role_final[0],
         role_final_b=verdict.role_final[1],
         give_way_vessels=_mmsi_list([v.mmsi for v in give_way]),
-        verdict_rests_on_defaults=_rests_on_defaults(
+        verdict_rests_on_defaults=rests_on_defaults(
             verdict,
             (a.dimensions, b.dimensions),
             (a.estimated_restricted, b.estimated_restricted),
+            (a.nav_status, b.nav_status),
+            restricted_nav_statuses,
         ),
         range_m_at_trigger=float(trigger["range_m"]),
         cpa_m=float(trigger["cpa_m"]),

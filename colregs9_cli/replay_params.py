@@ -43,8 +43,10 @@ class ReplayParams:
     - ``candidate_range_m``: pairs closer than this (inclusive) are candidates (2 nm).
     - ``tcpa_act_s``, ``cpa_req_m``: an encounter triggers at the first step with
       ``0 <= TCPA <= tcpa_act_s`` and ``CPA < cpa_req_m``.
-    - ``course_change_deg``, ``speed_change_frac``: a vessel "acted" when her course changed by
-      at least this many degrees, or her speed by at least this fraction, before CPA.
+    - ``course_change_deg``, ``speed_change_frac``, ``speed_change_min_kn``: a vessel "acted"
+      when her course changed by at least this many degrees, or her speed by at least this
+      fraction of her speed at the trigger and at least ``speed_change_min_kn`` (SOG noise:
+      0.6 to 0.98 kn is no action), before CPA.
     - ``course_judged_above_kn``: a course change counts only at speeds of at least this much,
       where COG means something (at 0.5 kn it is mostly GPS noise).
     - ``restricted_nav_statuses``: AIS navigational status codes that mean "restricted
@@ -68,6 +70,7 @@ class ReplayParams:
     cpa_req_m: float = 150.0
     course_change_deg: float = 15.0
     speed_change_frac: float = 0.25
+    speed_change_min_kn: float = 1.0
     course_judged_above_kn: float = 2.0
     restricted_nav_statuses: frozenset[int] = frozenset({3, 4})
     reassess_every_s: float = 10.0
@@ -107,7 +110,7 @@ class ReplayParams:
                     f"[replay] {name} = {value!r}: give a positive number, or leave it out to "
                     "take defaults by ship type"
                 )
-        for name in ("min_sog_kn", "tcpa_act_s", "course_judged_above_kn"):
+        for name in ("min_sog_kn", "tcpa_act_s", "course_judged_above_kn", "speed_change_min_kn"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
                 raise ParameterError(f"[replay] {name} = {value!r}: give a number >= 0")

@@ -15,7 +15,12 @@ from colregs9_cli.audit import (
     passage,
 )
 
-PARAMS = ConductParams(course_change_deg=15.0, speed_change_frac=0.25, course_judged_above_kn=2.0)
+PARAMS = ConductParams(
+    course_change_deg=15.0,
+    speed_change_frac=0.25,
+    speed_change_min_kn=1.0,
+    course_judged_above_kn=2.0,
+)
 
 
 def test_passage_is_the_first_opening_step_and_the_least_range_before_it() -> None:
@@ -44,6 +49,11 @@ def test_the_trigger_row_itself_never_counts_as_the_pass() -> None:
         ([90.0, 90.0, 90.0], [10.0, 8.0, 7.6], Fact.FALSE, Action.NONE, None),  # 24 % slower
         ([90.0, 90.0, 90.0], [10.0, 8.0, 7.5], Fact.TRUE, Action.SLOWED, 2),
         ([90.0, 90.0, 90.0], [8.0, 9.0, 10.0], Fact.TRUE, Action.SPED_UP, 2),
+        # 25 % of a slow vessel's speed is SOG noise below 1 kn (DMA 211219630: 0.60 → 0.98)
+        ([90.0, 90.0, 90.0], [0.6, 0.8, 0.98], Fact.INSUFFICIENT, Action.INSUFFICIENT, None),
+        ([90.0, 90.0, 90.0], [2.0, 2.5, 2.99], Fact.FALSE, Action.NONE, None),
+        ([90.0, 90.0, 90.0], [2.0, 2.5, 3.0], Fact.TRUE, Action.SPED_UP, 2),
+        ([90.0, 90.0, 90.0], [0.6, 1.2, 1.6], Fact.TRUE, Action.SPED_UP, 2),
         # the first change in time is the action
         ([90.0, 90.0, 120.0], [10.0, 7.0, 7.0], Fact.TRUE, Action.SLOWED, 1),
     ],

@@ -388,3 +388,19 @@ def test_parameters_from_a_toml_table() -> None:
         colregs_params_from_table({"head_on": 8}, "q.toml [colregs]")
     with pytest.raises(QueryError, match="course_source"):
         colregs_params_from_table({"course_source": "gyro"}, "q.toml [colregs]")
+
+
+def test_a_slow_vessels_cog_makes_the_situation_ambiguous() -> None:
+    # a clear crossing (target 45° on the starboard bow heading west), far from any sector
+    # boundary; speeds in m/s
+    own, target = ship(0, 0, 0.0, 5.0), ship(1000, 1000, 270.0, 5.0)
+    assert not evaluate_colregs(own, target, PARAMS, course_judged_above_kn=2.0).ambiguous[0]
+    slow_target = ship(1000, 1000, 270.0, 0.9)  # 1.75 kn: her COG is noise
+    slow = evaluate_colregs(own, slow_target, PARAMS, course_judged_above_kn=2.0)
+    assert slow.situation[0] is CROSSING and slow.ambiguous[0]
+    assert evaluate_colregs(slow_target, own, PARAMS, course_judged_above_kn=2.0).ambiguous[0]
+    # her heading is no noise: with course_source = heading and a heading, not ambiguous
+    by_heading = ColregsParams(course_source=CourseSource.HEADING)
+    steered = ship(1000, 1000, 270.0, 0.9, heading=270.0)
+    assert not evaluate_colregs(own, steered, by_heading, course_judged_above_kn=2.0).ambiguous[0]
+    assert evaluate_colregs(own, slow_target, by_heading, course_judged_above_kn=2.0).ambiguous[0]
