@@ -11,6 +11,7 @@ velocities must be grid directions: ``grid = true − γ``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,6 +23,10 @@ from .units import wrap_deg
 
 # Where the series for the meridian convergence holds to 1.6e-5° (``grid_convergence_deg``).
 _SERIES_REACH_DEG = 10.0
+# How far from its origin a frame places positions: a transverse Mercator scale is about
+# 1 + d²/2R², 0.2 % at 400 km. Beyond, positions have no frame coordinates.
+FRAME_REACH_M = 400_000.0
+MEAN_EARTH_RADIUS_M = 6_371_008.8
 
 
 @dataclass(frozen=True)
@@ -49,6 +54,19 @@ class LocalFrame:
         object.__setattr__(self, "_forward", Transformer.from_crs("EPSG:4326", crs, always_xy=True))
         object.__setattr__(self, "_inverse", Transformer.from_crs(crs, "EPSG:4326", always_xy=True))
         object.__setattr__(self, "_proj", Proj(crs))
+
+    def within_reach(self, lat_deg: ArrayLike, lon_deg: ArrayLike) -> NDArray[np.bool_]:
+        """Whether positions lie within ``FRAME_REACH_M`` of the origin (great circle on the
+        mean sphere), where the frame's scale is within 0.2 % of true."""
+        lat = np.radians(np.asarray(lat_deg, dtype=float))
+        dlon = np.radians(np.asarray(lon_deg, dtype=float) - self.lon0_deg)
+        lat0 = math.radians(self.lat0_deg)
+        half_chord_sq = (
+            np.sin((lat - lat0) / 2.0) ** 2 + math.cos(lat0) * np.cos(lat) * np.sin(dlon / 2.0) ** 2
+        )
+        with np.errstate(invalid="ignore"):
+            angle = 2.0 * np.arcsin(np.sqrt(np.clip(half_chord_sq, 0.0, 1.0)))
+            return np.asarray(angle * MEAN_EARTH_RADIUS_M <= FRAME_REACH_M)
 
     @classmethod
     def centred_on(
@@ -107,7 +125,9 @@ class LocalFrame:
         if far.any():
             # PROJ reports an unknown position as inf, not NaN: only known ones go in.
             factors = self._proj.get_factors(lon[far], lat[far])
-            gamma[far] = np.asarray(factors.meridian_convergence, dtype=float)
+            far_gamma = np.asarray(factors.meridian_convergence, dtype=float)
+            # Beyond the projection's reach PROJ answers inf: no grid direction there.
+            gamma[far] = np.where(np.isfinite(far_gamma), far_gamma, np.nan)
         return np.asarray(gamma, dtype=float)
 
     def true_to_grid_deg(
@@ -155,6 +175,27 @@ def ecef_m(lat_deg: ArrayLike, lon_deg: ArrayLike) -> NDArray[np.float64]:
         ],
         axis=-1,
     )
+
+
+def surface_normal(lat_deg: ArrayLike, lon_deg: ArrayLike) -> NDArray[np.float64]:
+    """The unit normal to the ellipsoid (the "n-vector", shape ``(..., 3)``) at WGS84 positions.
+
+    Interpolating normals between two reports and normalising gives positions on the Earth
+    with no map frame, across the antimeridian and at the poles too (``normal_to_lat_lon``).
+    """
+    lat = np.radians(np.asarray(lat_deg, dtype=float))
+    lon = np.radians(np.asarray(lon_deg, dtype=float))
+    return np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
+
+
+def normal_to_lat_lon(
+    x: ArrayLike, y: ArrayLike, z: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """WGS84 (lat_deg, lon_deg) of (not necessarily unit) surface normals."""
+    x, y, z = (np.asarray(v, dtype=float) for v in (x, y, z))
+    lat_deg = np.degrees(np.arctan2(z, np.hypot(x, y)))
+    lon_deg = np.degrees(np.arctan2(y, x))
+    return lat_deg, lon_deg
 
 
 def north_east_units(

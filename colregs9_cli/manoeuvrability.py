@@ -493,3 +493,30 @@ def assess_manoeuvrability(
         a_m=a_m,
         b_m=b_m,
     )
+
+
+def unplaced_assessment(
+    length_m: float, breadth_m: float, draught_m: float, params: ManoeuvrabilityParams
+) -> ManoeuvrabilityAssessment:
+    """The estimate for a vessel that has no place in the run's map frame (far beyond its
+    reach, where no chart is): ``unknown``, with no projected positions."""
+    rate = params.alpha * target_rate_of_swing_deg_per_m(length_m, params)
+    empty = np.empty(0, dtype=float)
+    return ManoeuvrabilityAssessment(
+        restriction=Restriction.UNKNOWN,
+        policy=params.policy,
+        rate_of_swing_deg_per_m=rate,
+        turn_radius_m=1.0 / math.radians(rate) if rate > 0.0 else math.inf,
+        arc=np.empty(0, dtype=str),
+        step=np.empty(0, dtype=np.int64),
+        north_m=empty,
+        east_m=empty,
+        heading_deg=empty,
+        restricted=np.empty(0, dtype=bool),
+        covered=np.empty(0, dtype=bool),
+        length_m=length_m,
+        breadth_m=breadth_m,
+        draught_m=draught_m,
+        a_m=params.domain_length_factor * length_m,
+        b_m=params.domain_breadth_factor * breadth_m,
+    )

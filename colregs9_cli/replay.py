@@ -72,6 +72,7 @@ from .manoeuvrability import (
     ManoeuvrabilityParams,
     Restriction,
     assess_manoeuvrability,
+    unplaced_assessment,
 )
 from .progress import progress_bar, progress_enabled
 from .query import Query, everything_query, load_query
@@ -145,17 +146,20 @@ def run_params(
 
 
 def run_frame(query: Query, extent: Extent, chart: ChartSource | None = None) -> LocalFrame:
-    """The query region's frame; without one, a frame centred on the charts (where the
-    manoeuvrability estimate is made), else on the data (``slabs.Extent.frame``).
+    """A frame centred on the charts, where the manoeuvrability estimate is made; without
+    charts, on the query region, else on the data (``slabs.Extent.frame``).
 
     The frame carries the chart, the manoeuvrability estimate and the figures; the geometry
-    between vessels never uses it (``encounters.py``).
+    between vessels never uses it (``encounters.py``), and the tracks are resampled on the
+    Earth, so a position beyond its reach only loses its frame coordinates. The charts come
+    first because a national query's centre may lie hundreds of kilometres from a harbour
+    cell, where the frame's scale would bend the ship domains.
     """
+    if chart is not None:
+        return LocalFrame.centred_on(*chart.bounds_wgs84())
     frame = query.frame()
     if frame is not None:
         return frame
-    if chart is not None:
-        return LocalFrame.centred_on(*chart.bounds_wgs84())
     return extent.frame()
 
 
@@ -203,17 +207,24 @@ class _Estimator:
         """The estimate for ``row`` of the vessel's state arrays (made anew when due)."""
         stale = self.assessment is None or row - self.assessed_row >= self.reassess_steps
         if self.assessment is None or (needed and stale):
-            self.assessment = assess_manoeuvrability(
-                self.chart,
-                float(state["north_m"][row]),
-                float(state["east_m"][row]),
-                float(state["course_deg"][row]),
-                float(state["speed_mps"][row]),
-                self.dimensions.length_m,
-                self.dimensions.breadth_m,
-                self.dimensions.draught_m,
-                self.params,
-            )
+            dims = self.dimensions
+            placed = all(math.isfinite(state[name][row]) for name in ("north_m", "east_m"))
+            if placed and math.isfinite(state["course_deg"][row]):
+                self.assessment = assess_manoeuvrability(
+                    self.chart,
+                    float(state["north_m"][row]),
+                    float(state["east_m"][row]),
+                    float(state["course_deg"][row]),
+                    float(state["speed_mps"][row]),
+                    dims.length_m,
+                    dims.breadth_m,
+                    dims.draught_m,
+                    self.params,
+                )
+            else:
+                self.assessment = unplaced_assessment(
+                    dims.length_m, dims.breadth_m, dims.draught_m, self.params
+                )
             self.assessed_row = row
         return self.assessment
 

@@ -47,7 +47,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-from .geo import LocalFrame, ecef_m, true_bearing_deg
+from .geo import LocalFrame, ecef_m, normal_to_lat_lon, surface_normal, true_bearing_deg
 from .replay_params import CourseSource, ReplayParams
 from .units import MPS_PER_KNOT, signed_angle_deg, wrap_deg
 
@@ -330,21 +330,36 @@ def resample_reports(
     heading_deg = kept["heading_deg"].to_numpy(dtype=float)
     heading_deg = np.where(np.isnan(heading_deg), cog_deg, heading_deg)
     course_deg = heading_deg if course_source is CourseSource.HEADING else cog_deg
-    north, east = frame.to_local(lat, lon)
+    # Positions are interpolated on the Earth (surface normals), not in the map frame, which
+    # is undefined far from its centre; the frame's coordinates are then only derived.
+    normal = surface_normal(lat, lon)
     samples = _resample(
         segment_start,
         mmsi,
         t,
-        {"north_m": north, "east_m": east, "sog_kn": sog_kn},
+        {
+            "normal_x": normal[:, 0],
+            "normal_y": normal[:, 1],
+            "normal_z": normal[:, 2],
+            "sog_kn": sog_kn,
+        },
         {"cog_deg": cog_deg, "heading_deg": heading_deg, "course_deg": course_deg},
         kept["nav_status"].to_numpy(dtype=float),
         params.step_s,
     )
     if steps is not None:
         samples = samples[samples["step"].between(*steps)].reset_index(drop=True)
-    sample_lat, sample_lon = frame.to_geodetic(samples["north_m"], samples["east_m"])
+    sample_lat, sample_lon = normal_to_lat_lon(
+        samples["normal_x"], samples["normal_y"], samples["normal_z"]
+    )
     samples["lat_deg"] = sample_lat
     samples["lon_deg"] = sample_lon
+    north, east = frame.to_local(sample_lat, sample_lon)
+    # Beyond the frame's reach its scale bends (and PROJ may answer inf): such a sample has
+    # no frame position, while its geometry between vessels stays exact.
+    placed = frame.within_reach(sample_lat, sample_lon) & np.isfinite(north) & np.isfinite(east)
+    samples["north_m"] = np.where(placed, north, np.nan)
+    samples["east_m"] = np.where(placed, east, np.nan)
     convergence_deg = frame.grid_convergence_deg(sample_lat, sample_lon)
     for name in ("cog", "heading", "course"):
         samples[f"{name}_grid_deg"] = wrap_deg(samples[f"{name}_deg"] - convergence_deg)

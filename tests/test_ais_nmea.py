@@ -17,15 +17,17 @@ from pyais import encode_dict
 from colregs9_cli.ais.batch import AisBatch
 from colregs9_cli.ais.clean import SHIP_TYPE_CATEGORIES
 from colregs9_cli.ais.ledger import RejectReason, RejectsLedger
-from colregs9_cli.ais.nmea import TimeSource, pghp_time_ms, read_nmea
+from colregs9_cli.ais.nmea import DEFAULT_TIME_SOURCES, TimeSource, pghp_time_ms, read_nmea
 from colregs9_cli.errors import InputFileError
 
 NOON = 1_384_257_600  # 2013-11-12 12:00:00 UTC
 
 
-def _read(lines: list[str]) -> tuple[AisBatch, RejectsLedger]:
+def _read(
+    lines: list[str], time_sources: tuple[TimeSource, ...] = DEFAULT_TIME_SOURCES
+) -> tuple[AisBatch, RejectsLedger]:
     ledger = RejectsLedger()
-    batches = list(read_nmea(lines, "log.nmea", ledger))
+    batches = list(read_nmea(lines, "log.nmea", ledger, time_sources))
     assert len(batches) == 1
     batch = batches[0]
     # Every message is one output row or one reader reject.
@@ -125,6 +127,24 @@ def test_a_tag_block_c_beats_a_pending_pghp_time() -> None:
     pghp = _pghp(datetime(2013, 11, 12, 13, 0, 0, tzinfo=UTC))
     batch, _ = _read([pghp, _tag(f"c:{NOON}") + _position()])
     assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 0, 0, tzinfo=UTC)
+
+
+def test_a_whole_second_tag_block_gives_way_to_the_pghp_milliseconds_of_its_second() -> None:
+    # The DMA layout of dma-ais: "\\c:<seconds>\\" on the sentence and a $PGHP before it.
+    fine = datetime(2013, 11, 12, 12, 0, 18, 375_000, tzinfo=UTC)
+    batch, ledger = _read([_pghp(fine), _tag(f"c:{NOON + 18}") + _position()])
+    assert _rows(batch.positions)[0]["timestamp"] == fine
+    assert ledger.time_sources == {"pghp": 1}
+    # Another second is another observation: the tag block's order holds.
+    later = datetime(2013, 11, 12, 12, 0, 19, 375_000, tzinfo=UTC)
+    batch, _ = _read([_pghp(later), _tag(f"c:{NOON + 18}") + _position()])
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 0, 18, tzinfo=UTC)
+    # A $PGHP left out of the sources in use lends no milliseconds.
+    batch, _ = _read(
+        [_pghp(fine), _tag(f"c:{NOON + 18}") + _position()],
+        time_sources=(TimeSource.TAG_BLOCK,),
+    )
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(2013, 11, 12, 12, 0, 18, tzinfo=UTC)
 
 
 def test_bare_sentence_without_any_time_is_unparseable_with_an_example() -> None:

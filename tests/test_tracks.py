@@ -96,10 +96,11 @@ def test_isolated_speed_jump_is_dropped_and_counted() -> None:
     assert tracks.stats.jump_splits == 0
     assert tracks.stats.segments == 1
     assert tracks.stats.reports_used == 5
-    # The dropped report leaves no trace: t=30 is interpolated from t=20 and t=40.
+    # The dropped report leaves no trace: t=30 is interpolated from t=20 and t=40 (on the
+    # Earth, so the frame sees the midpoint to a fraction of a millimetre).
     at_30 = tracks.samples.loc[tracks.samples["step"] == T0_S + 30]
-    assert at_30["north_m"].item() == pytest.approx(150.0, abs=1e-6)
-    assert at_30["east_m"].item() == pytest.approx(0.0, abs=1e-6)
+    assert at_30["north_m"].item() == pytest.approx(150.0, abs=1e-4)
+    assert at_30["east_m"].item() == pytest.approx(0.0, abs=1e-4)
 
 
 def test_last_report_jumping_is_dropped() -> None:
@@ -144,11 +145,12 @@ def test_same_second_reports_keep_the_first() -> None:
 
 
 def test_positions_and_speed_are_linear_in_time() -> None:
+    # Linear on the Earth between reports: in the frame, to a fraction of a millimetre.
     frame = reports([0, 10], [0.0, 100.0], [0.0, -40.0], sog_kn=[4.0, 6.0], cog_deg=350.0)
     samples = build_tracks(frame, FRAME, ReplayParams()).samples
     at_3 = samples.loc[samples["step"] == T0_S + 3].iloc[0]
-    assert at_3["north_m"] == pytest.approx(30.0, abs=1e-6)
-    assert at_3["east_m"] == pytest.approx(-12.0, abs=1e-6)
+    assert at_3["north_m"] == pytest.approx(30.0, abs=1e-4)
+    assert at_3["east_m"] == pytest.approx(-12.0, abs=1e-4)
     assert at_3["sog_kn"] == pytest.approx(4.6)
     assert at_3["speed_mps"] == pytest.approx(4.6 * 1852 / 3600)
     lat, lon = FRAME.to_geodetic(30.0, -12.0)
@@ -367,3 +369,17 @@ def test_grid_courses_far_from_the_central_meridian() -> None:
     turn = samples["heading_deg"] - samples["heading_grid_deg"]
     assert turn.to_numpy() == pytest.approx(samples["cog_deg"] - samples["cog_grid_deg"])
     assert (samples["course_grid_deg"] == samples["heading_grid_deg"]).all()
+
+
+def test_a_track_across_the_antimeridian_is_resampled_on_the_earth() -> None:
+    # Two reports 10 s apart either side of 180°: the sample between lies on 180°, not on the
+    # far side of the Earth, and a frame that cannot reach it leaves its frame position empty.
+    crossing = reports([0, 10], [0.0, 0.0], [0.0, 0.0], sog_kn=[10.0, 10.0], cog_deg=90.0)
+    crossing["lat_deg"] = [0.0, 0.0]
+    crossing["lon_deg"] = [179.9998, -179.9998]
+    far_frame = LocalFrame(0.0, 10.0)
+    samples = build_tracks(crossing, far_frame, ReplayParams()).samples
+    middle = samples.loc[samples["step"] == T0_S + 5].iloc[0]
+    assert abs(middle["lon_deg"]) == pytest.approx(180.0, abs=1e-9)
+    assert middle["lat_deg"] == pytest.approx(0.0, abs=1e-12)
+    assert np.isnan(middle["north_m"]) and np.isnan(middle["east_m"])

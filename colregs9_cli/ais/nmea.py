@@ -13,7 +13,9 @@ Timestamps, kept to the millisecond. A sentence can carry up to three times (``T
 
 The observation wins over the arrival: by default ``tag_block``, then ``pghp``, then
 ``arrival`` (``DEFAULT_TIME_SOURCES``; ``read_nmea``'s ``time_sources`` changes the order or
-leaves a source out). Each message's source is counted in the ledger (``time_sources``). Any
+leaves a source out). A whole-second observation time gives way to the other observation
+source's time of the same second with milliseconds (DMA lines carry a ``c:`` in seconds and a
+``$PGHP`` with milliseconds). Each message's source is counted in the ledger (``time_sources``). Any
 sentence line (AIS or not) consumes the pending times, because ``$PGHP`` stamps exactly the
 next sentence. A tag block whose checksum fails gives no time; so does a ``$PGHP`` line whose
 checksum or date fails. ``c:`` and trailing values above 1e11 are taken as milliseconds. A
@@ -284,7 +286,9 @@ class _NmeaReader:
         if arrival_ms is not None:
             available[TimeSource.ARRIVAL] = arrival_ms
         stamp = next(((available[s], s) for s in self.time_sources if s in available), None)
-        self._ais_sentence(line_no, sentence_text, stamp)
+        self._ais_sentence(
+            line_no, sentence_text, _finer_observation(stamp, available, self.time_sources)
+        )
 
     def _tag_block_time(self, tag_block: str) -> int | None:
         if "c:" not in tag_block:
@@ -478,6 +482,22 @@ def _append_static(
     columns.mmsi.append(decoded.mmsi)
     columns.msg_type.append(msg_type)
     _append_static_fields(columns, decoded)
+
+
+def _finer_observation(
+    stamp: tuple[int, TimeSource] | None,
+    available: dict[TimeSource, int],
+    in_use: Sequence[TimeSource],
+) -> tuple[int, TimeSource] | None:
+    """A whole-second observation time gives way to the other observation source's time of
+    the same second with milliseconds (a DMA line with ``c:`` seconds and a ``$PGHP``)."""
+    if stamp is None or stamp[1] is TimeSource.ARRIVAL or stamp[0] % 1000:
+        return stamp
+    for source in (TimeSource.TAG_BLOCK, TimeSource.PGHP):
+        finer = available.get(source) if source in in_use else None
+        if finer is not None and finer % 1000 and finer // 1000 == stamp[0] // 1000:
+            return finer, source
+    return stamp
 
 
 def _split_time_suffix(text: str) -> tuple[str, int | None]:
