@@ -62,6 +62,7 @@ from pyproj.exceptions import CRSError
 
 from .errors import ChartError, ParameterError
 from .geo import LocalFrame
+from .s57_updates import update_files_beside
 
 HAZARD_RADIUS_M = 10.0
 # Depth areas that should meet often leave slivers of gap between them (or of land filling the
@@ -590,26 +591,10 @@ class CellInfo:
     scale: int | None = None  # compilation scale denominator (DSPM CSCL)
 
 
-def _update_files(path: Path) -> tuple[list[Path], list[str]]:
-    """The update files ``X.001``, ``X.002`` … beside the base cell ``X.000``, and the names
-    of those missing below the highest one present."""
-    numbers = sorted(
-        int(candidate.suffix[1:])
-        for candidate in path.parent.glob(f"{path.stem}.*")
-        if len(candidate.suffix) == 4
-        and candidate.suffix[1:].isdigit()
-        and candidate.suffix != ".000"
-    )
-    present = set(numbers)
-    highest = numbers[-1] if numbers else 0
-    missing = [f"{path.stem}.{n:03d}" for n in range(1, highest + 1) if n not in present]
-    return [path.with_suffix(f".{n:03d}") for n in numbers], missing
-
-
 def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
     """The cell's edition, update number and issue date; a gap in its update sequence is a
     ``ChartError`` unless ``accept_gaps`` (GDAL would stop at the gap without a word)."""
-    updates, missing = _update_files(path)
+    updates, missing = update_files_beside(path)
     if missing and not accept_gaps:
         raise ChartError(
             f"{path}: the update sequence has a gap, {', '.join(missing)} missing beside "

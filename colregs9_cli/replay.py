@@ -835,6 +835,7 @@ def build_manifest(
     track_stats: TrackStats,
     counts: ReplayCounts,
     pairs: tuple[PairOutcome, ...],
+    accept_chart_gaps: bool = False,
 ) -> dict[str, Any]:
     """The content of run.json."""
     return {
@@ -844,6 +845,7 @@ def build_manifest(
         "parameters": jsonable(params),
         "inputs": inputs_manifest(inputs),
         "charts": charts_manifest(chart_paths),
+        "accept_chart_gaps": accept_chart_gaps,
         "chart_cells": [jsonable(cell) for cell in (chart.cells if chart is not None else ())],
         "ledger": ledger.to_dict(),
         "ledger_balanced": ledger.balanced,
@@ -953,6 +955,7 @@ def run_replay(
             track_stats,
             counts,
             tuple(outcomes),
+            accept_chart_gaps,
         )
         manifest["slabs"] = {
             "slab_s": slab_s,

@@ -3,6 +3,7 @@ update sequence is never silent (GDAL would apply the updates before it and stop
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
 from pathlib import Path
@@ -91,3 +92,12 @@ def test_replay_records_the_cells_in_run_json(tmp_path: Path, gap: Path) -> None
     (cell,) = manifest["chart_cells"]
     assert cell["edition"] == 56 and cell["update_number"] == 0
     assert cell["missing_updates"] == ["US5CA72M.001"]
+    assert manifest["accept_chart_gaps"] is True
+    # The update that the gap left unapplied is recorded too, with its hash.
+    (chart,) = manifest["charts"]
+    assert chart["missing_updates"] == ["US5CA72M.001"]
+    files = {Path(f["path"]).name: f for f in chart["files"]}
+    assert set(files) == {"US5CA72M.000", "US5CA72M.002"}
+    assert files["US5CA72M.000"]["applied"] and not files["US5CA72M.002"]["applied"]
+    for item in files.values():
+        assert item["sha256"] == hashlib.sha256(Path(item["path"]).read_bytes()).hexdigest()

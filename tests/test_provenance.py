@@ -110,6 +110,7 @@ def test_charts_are_recorded_with_every_file_and_its_hash() -> None:
     assert cell["path"] == str(SANDIEGO_ENC)
     names = [Path(f["path"]).name for f in cell["files"]]
     assert names == ["US5CA72M.000", "US5CA72M.001", "US5CA72M.002"]
+    assert all(f["applied"] for f in cell["files"]) and cell["missing_updates"] == []
     for item in cell["files"]:
         assert item["sha256"] == _sha256(Path(item["path"]))
     (modelled,) = charts_manifest([MODELLED_CHART])

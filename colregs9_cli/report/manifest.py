@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import pandas as pd
 
 from .. import __version__
+from ..s57_updates import update_files_beside
 
 if TYPE_CHECKING:
     from ..ais.load import InputFile
@@ -59,22 +60,23 @@ def run_header(command: str) -> dict[str, Any]:
 
 
 def charts_manifest(paths: Sequence[Path]) -> list[dict[str, Any]]:
-    """Each chart given, with every file that went into it and its sha256: an S-57 base
-    cell ``X.000`` with the update files ``X.001``, ``X.002`` … that lie beside it."""
+    """Each chart given, with every file that went into it or lies beside it and its sha256:
+    an S-57 base cell ``X.000`` with the update files ``X.001``, ``X.002`` …, each marked
+    ``applied`` or not (GDAL applies none after a gap), and the names of those missing."""
     charts = []
     for path in paths:
-        files = [path]
-        if path.suffix == ".000":
-            number = 1
-            while (update := path.with_suffix(f".{number:03d}")).is_file():
-                files.append(update)
-                number += 1
-        charts.append(
+        updates, missing = update_files_beside(path) if path.suffix == ".000" else ([], [])
+        first_gap = min((int(name.rsplit(".", 1)[1]) for name in missing), default=None)
+        files = [{"path": str(path), "sha256": _sha256(path), "applied": True}]
+        files += [
             {
-                "path": str(path),
-                "files": [{"path": str(f), "sha256": _sha256(f)} for f in files],
+                "path": str(update),
+                "sha256": _sha256(update),
+                "applied": first_gap is None or int(update.suffix[1:]) < first_gap,
             }
-        )
+            for update in updates
+        ]
+        charts.append({"path": str(path), "files": files, "missing_updates": missing})
     return charts
 
 
