@@ -6,16 +6,63 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
+from typer.core import TyperCommand
 
 from . import __version__
 from .errors import Colregs9Error
 from .quick_exit import run_and_exit
 
-# --quiet means the same everywhere: no progress on stderr; results and errors still print.
-QUIET_HELP = "No progress bars on stderr (also off when stderr is not a terminal)."
+# --quiet means the same everywhere: stdout carries the results, stderr the progress and the
+# closing line that says where the files went; --quiet silences stderr but for errors.
+QUIET_HELP = (
+    "No progress bars and no closing line naming the files written, both on stderr "
+    "(progress bars are also off when stderr is not a terminal). Results and errors still print."
+)
+OVERWRITE_HELP = "Replace an --out directory that holds something other than a colregs9 report."
+# What every AIS reader takes (ais/sources.py tells the compression from the first bytes).
+AIS_FILES_HELP = (
+    "AIS files: DMA CSV (22 or 26 columns), MarineCadastre CSV, raw NMEA or canonical Parquet; "
+    "plain or compressed (gzip, bzip2, xz, zstd, or a zip holding one file)"
+)
+DATASETS_HELP = "; or dataset directories made by colregs9 ingest."
+# The values of ais.detect.LAYOUTS, written out: importing it would load pyarrow for --help.
+LAYOUT_HELP = "Input layout instead of detecting it: dma26, dma22, marinecadastre, nmea, parquet."
+# What chart.py reads, told by the suffix.
+CHART_FORMATS = (
+    "S-57 base cell .000 (with its updates .001, .002 … beside it), GeoJSON (.geojson, .json) "
+    "or GeoPackage (.gpkg)"
+)
+
+
+class _Command(TyperCommand):
+    """A command whose help lists each argument by its metavar alone.
+
+    typer 0.29 writes an argument as ``AIS <list[Path]>``: the metavar, then its Python type,
+    which means nothing to a user. Options already show their metavar alone.
+    """
+
+    # Any: the context and formatter are of the click that typer vendors (typer._click), a
+    # private module.
+    def format_options(self, ctx: Any, formatter: Any) -> None:
+        arguments: list[tuple[str, str]] = []
+        options: list[tuple[str, str]] = []
+        for param in self.get_params(ctx):
+            record = param.get_help_record(ctx)
+            if record is None:
+                continue
+            if param.param_type_name == "argument":
+                name = param.metavar or (param.name or "").upper()
+                arguments.append((name + ("..." if param.nargs != 1 else ""), record[1]))
+            else:
+                options.append(record)
+        for title, rows in (("Arguments", arguments), ("Options", options)):
+            if rows:
+                with formatter.section(title):
+                    formatter.write_dl(rows)
+
 
 app = typer.Typer(
     name="colregs9",
@@ -56,14 +103,13 @@ def main(
     """
 
 
-@app.command("replay")
+@app.command("replay", cls=_Command)
 def replay_command(
     ais: Annotated[
         list[Path],
         typer.Argument(
             metavar="AIS",
-            help="AIS files: DMA CSV (22/26 columns), MarineCadastre CSV or raw NMEA (.gz ok); "
-            "or dataset directories made by colregs9 ingest.",
+            help=AIS_FILES_HELP + DATASETS_HELP,
         ),
     ],
     chart: Annotated[
@@ -71,7 +117,7 @@ def replay_command(
         typer.Option(
             "--chart",
             metavar="CHART",
-            help="Chart file (S-57 .000, GeoJSON, GeoPackage); repeatable.",
+            help=f"Chart file: {CHART_FORMATS}; repeatable.",
         ),
     ] = None,
     query: Annotated[
@@ -105,7 +151,7 @@ def replay_command(
         typer.Option(
             "--format",
             metavar="LAYOUT",
-            help="Input layout, when it cannot be detected from the file.",
+            help=LAYOUT_HELP,
         ),
     ] = None,
     step_s: Annotated[
@@ -147,10 +193,7 @@ def replay_command(
     ] = False,
     overwrite: Annotated[
         bool,
-        typer.Option(
-            "--overwrite",
-            help="Replace an --out directory that holds something other than a colregs9 report.",
-        ),
+        typer.Option("--overwrite", help=OVERWRITE_HELP),
     ] = False,
     slab_minutes: Annotated[
         float | None,
@@ -191,11 +234,15 @@ def replay_command(
 ) -> None:
     """Replay AIS pair by pair through COLREGs rules 13–15 and the rule 9 automaton.
 
-    Writes pairs.csv (one verdict per pair, the same from both seats), encounters.csv (one row
-    per seat), encounters/<id>.csv and .png, index.md and run.json, and prints one line per
-    triggered pair. Without --chart, manoeuvrability is "unknown".
+    Prints one line per triggered pair and writes to --out: pairs.csv (one verdict per pair,
+    the same from both seats), encounters.csv (one row per seat), encounters/<id>.csv and
+    .png, report.gpkg (the encounters, tracks, CPAs and domains in WGS84, for QGIS),
+    index.html (the report as one web page), index.md and run.json. Without --chart,
+    manoeuvrability is "unknown".
 
-    Example: colregs9 replay fixtures/ais/dma_nmea_2013-11-12_5min.txt.gz --no-plots
+    \b
+    Example:
+      colregs9 replay fixtures/ais/dma_nmea_2013-11-12_5min.txt.gz --no-plots
     """
     from .replay import run_replay
 
@@ -227,15 +274,18 @@ def replay_command(
             scratch_dir=scratch,
         )
     typer.echo(result.text, nl=False)
-    typer.echo(f"Reports in {result.out_dir}")
+    if not quiet:
+        typer.echo(f"Reports in {result.out_dir}", err=True)
 
 
-@app.command("simulate")
+@app.command("simulate", cls=_Command)
 def simulate_command(
     scenario: Annotated[
         Path,
         typer.Argument(
-            metavar="SCENARIO.toml", help="Scenario TOML (vessels, routes, speeds, timing, chart)."
+            metavar="SCENARIO.toml",
+            help="Scenario TOML (vessels, routes, speeds, timing) naming its chart: "
+            f"{CHART_FORMATS}.",
         ),
     ],
     out: Annotated[
@@ -253,24 +303,26 @@ def simulate_command(
     Checks that every route lies in water navigable for that vessel's draught on the
     scenario's chart, then writes one report per vessel every ais_interval_s.
 
-    Example: colregs9 simulate colregs9_cli/data/demo/greenhopper_restricted.toml
+    \b
+    Example:
+      colregs9 simulate colregs9_cli/data/demo/greenhopper_restricted.toml
     """
     from .simulate import simulate_scenario
 
     with _user_errors():
         result = simulate_scenario(scenario, out, quiet=quiet)
     typer.echo(result.text, nl=False)
-    typer.echo(f"AIS written to {result.out_path}")
+    if not quiet:
+        typer.echo(f"AIS written to {result.out_path}", err=True)
 
 
-@app.command("stats")
+@app.command("stats", cls=_Command)
 def stats_command(
     ais: Annotated[
         list[Path],
         typer.Argument(
             metavar="AIS",
-            help="AIS files: DMA CSV (22/26 columns, .gz/.zip ok), MarineCadastre CSV, raw "
-            "NMEA or canonical Parquet; or dataset directories made by colregs9 ingest.",
+            help=AIS_FILES_HELP + DATASETS_HELP,
         ),
     ],
     query: Annotated[
@@ -299,8 +351,7 @@ def stats_command(
         typer.Option(
             "--format",
             metavar="LAYOUT",
-            help="Input layout instead of detecting it: dma26, dma22, marinecadastre, nmea, "
-            "parquet.",
+            help=LAYOUT_HELP,
         ),
     ] = None,
     out: Annotated[
@@ -311,20 +362,20 @@ def stats_command(
     ] = None,
     overwrite: Annotated[
         bool,
-        typer.Option(
-            "--overwrite",
-            help="Replace an --out directory that holds something other than a colregs9 report.",
-        ),
+        typer.Option("--overwrite", help=OVERWRITE_HELP),
     ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """Vessel dimension statistics (length, breadth, draught), like the paper's table.
 
-    Writes dimension_stats.csv, dimension_stats.md, dimension_histograms.png and run.json and
-    prints the table. std is the sample standard deviation (ddof = 1), empty below 2 values.
+    Prints the table and writes to --out: dimension_stats.csv, dimension_stats.md,
+    dimension_histograms.png, index.html (the table and histograms as one web page) and
+    run.json. std is the sample standard deviation (ddof = 1), empty below 2 values.
     Exit codes: 0 done, 2 bad input file, query or option, 3 the query selects no rows.
 
-    Example: colregs9 stats fixtures/ais/aisdk_2024-09-09_sample.csv --by ship_type
+    \b
+    Example:
+      colregs9 stats fixtures/ais/aisdk_2024-09-09_sample.csv --by ship_type
     """
     from .stats import run_stats
 
@@ -344,14 +395,13 @@ def stats_command(
         typer.echo(f"Reports in {result.out_dir}", err=True)
 
 
-@app.command("ingest")
+@app.command("ingest", cls=_Command)
 def ingest_command(
     ais: Annotated[
         list[Path],
         typer.Argument(
             metavar="AIS",
-            help="AIS files: DMA CSV (22/26 columns, .gz/.zip ok), MarineCadastre CSV, raw "
-            "NMEA or canonical Parquet.",
+            help=AIS_FILES_HELP + ".",
         ),
     ],
     out: Annotated[
@@ -376,8 +426,7 @@ def ingest_command(
         typer.Option(
             "--format",
             metavar="LAYOUT",
-            help="Input layout instead of detecting it: dma26, dma22, marinecadastre, nmea, "
-            "parquet.",
+            help=LAYOUT_HELP,
         ),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
@@ -389,7 +438,10 @@ def ingest_command(
     sha256 and rejects ledger). A file already in the dataset is skipped; a new one (the next
     day) is added. Give DATASET to stats or replay in place of the files.
 
-    Example: colregs9 ingest fixtures/ais/aisdk_2024-09-09_sample.csv --out reports/ais-dataset
+    \b
+    Example:
+      colregs9 ingest fixtures/ais/aisdk_2024-09-09_sample.csv \\
+          --out reports/ais-dataset
     """
     from .ais.dataset import ingest
 
@@ -398,35 +450,41 @@ def ingest_command(
     typer.echo(result.text, nl=False)
 
 
-@app.command("swing")
+@app.command("swing", cls=_Command)
 def swing_command(
     out: Annotated[
         Path | None,
         typer.Option("--out", metavar="DIR", help="Output directory. Default: reports/swing/."),
     ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """The rate of swing of the paper's 14 reference vessels: table, CSV and figure.
 
-    Prints the table with rate_of_swing_deg_per_m = 360 / (2π·turn_radius_m) and writes
-    rate_of_swing.csv and rate_of_swing.png (rate of swing against length, one marker per class).
+    Prints the table with rate_of_swing_deg_per_m = 360 / (2π·turn_radius_m) and writes to
+    --out: rate_of_swing.csv, rate_of_swing.png (rate of swing against length, one marker per
+    class) and run.json.
 
-    Example: colregs9 swing --out reports/swing
+    \b
+    Example:
+      colregs9 swing --out reports/swing
     """
     from .swing import run_swing
 
     with _user_errors():
-        report = run_swing(out)
+        report = run_swing(out, overwrite=overwrite)
     typer.echo(report.text, nl=False)
-    typer.echo(f"Wrote {report.csv_path} and {report.png_path}")
+    if not quiet:
+        typer.echo(f"Reports in {report.out_dir}", err=True)
 
 
-@app.command("chart")
+@app.command("chart", cls=_Command)
 def chart_command(
     charts: Annotated[
         list[Path],
         typer.Argument(
             metavar="CHART",
-            help="Chart files (S-57 .000, GeoJSON, GeoPackage); several are merged.",
+            help=f"Chart files: {CHART_FORMATS}; several are merged.",
         ),
     ],
     draught: Annotated[
@@ -462,7 +520,9 @@ def chart_command(
 ) -> None:
     """Summarise charts: layers, depth range, extent; with --draught, the navigable water.
 
-    Example: colregs9 chart fixtures/charts/noaa_enc_US5MD1MC.000 --draught 5
+    \b
+    Example:
+      colregs9 chart fixtures/charts/noaa_enc_US5MD1MC.000 --draught 5
     """
     from .chartinfo import summarise_chart
 
@@ -478,7 +538,7 @@ def chart_command(
     typer.echo(summary.text, nl=False)
 
 
-@app.command("demo")
+@app.command("demo", cls=_Command)
 def demo_command(
     out: Annotated[
         Path | None,
@@ -496,7 +556,9 @@ def demo_command(
     chart: Annotated[
         Path | None,
         typer.Option(
-            "--chart", metavar="CHART", help="Chart for the replay. Default: the modelled chart."
+            "--chart",
+            metavar="CHART",
+            help=f"Chart for the replay: {CHART_FORMATS}. Default: the modelled chart.",
         ),
     ] = None,
     query: Annotated[
@@ -507,15 +569,19 @@ def demo_command(
             help="Query TOML with the paper's parameters. Default: the package's greenhopper.toml.",
         ),
     ] = None,
+    overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """The paper's Greenhopper case study: simulate and replay both scenarios, print the verdicts.
 
     Runs from any directory: the scenarios, the modelled chart and the query are package data.
-    Writes the AIS, the replay reports and one figure per scenario to the output directory.
-    Exit code 3 if a scenario gives own ship no triggered encounter.
+    Writes to --out, for each scenario, the AIS (simulate-<scenario>.csv), the replay's report
+    (<scenario>/) and its figure (<scenario>.png), and run.json. Exit code 3 if a scenario
+    gives own ship no triggered encounter.
 
-    Example: colregs9 demo --out reports/demo
+    \b
+    Example:
+      colregs9 demo --out reports/demo
     """
     from .demo import DEFAULT_CHART, DEFAULT_QUERY, DEFAULT_SCENARIOS_DIR, run_demo
 
@@ -526,6 +592,7 @@ def demo_command(
             scenarios_dir=scenarios or DEFAULT_SCENARIOS_DIR,
             chart=chart or DEFAULT_CHART,
             query=query or DEFAULT_QUERY,
+            overwrite=overwrite,
         )
     typer.echo(result.text, nl=False)
 

@@ -10,7 +10,11 @@ one output directory:
 - ``<scenario>/``: the replay's reports (encounters.csv, encounters/<id>.csv and .png,
   index.md, run.json);
 - ``<scenario>.png``: a copy of the encounter's figure, the paper's Figure "restricted" or
-  "not restricted".
+  "not restricted";
+- ``run.json``: the inputs and both verdicts.
+
+Like ``stats`` and ``replay``, the demo writes into a fresh directory that replaces the
+output directory whole at the end, and refuses one that holds something else.
 
 The inputs (the two scenarios, the modelled chart and the query) are package data in
 ``colregs9_cli/data/demo/``, so the demo runs from any directory after ``pip install``.
@@ -18,6 +22,7 @@ The inputs (the two scenarios, the modelled chart and the query) are package dat
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 from dataclasses import dataclass
 from importlib import resources
@@ -26,6 +31,8 @@ from pathlib import Path
 from .errors import InputFileError, NoDataError
 from .replay import run_replay
 from .replay_results import EncounterOutcome, ReplayResult
+from .report.atomic import REPORT_MARKER, check_out_dir, report_directory, write_json
+from .report.manifest import charts_manifest, run_header
 from .report.replay_report import ENCOUNTER_DIR
 from .simulate import SimulationResult, simulate_scenario
 
@@ -195,18 +202,60 @@ def run_scenario(
     )
 
 
+def _moved(verdict: ScenarioVerdict, staging: Path, out_dir: Path) -> ScenarioVerdict:
+    """The verdict with its paths, and the inputs its replay's manifest names, where the
+    staging directory's files are after the swap."""
+
+    def moved(path: Path) -> Path:
+        return out_dir / path.relative_to(staging) if path.is_relative_to(staging) else path
+
+    replay = verdict.replay
+    inputs = [
+        {**item, "path": str(moved(Path(item["path"])))} for item in replay.manifest["inputs"]
+    ]
+    return dataclasses.replace(
+        verdict,
+        simulation=dataclasses.replace(
+            verdict.simulation, out_path=moved(verdict.simulation.out_path)
+        ),
+        replay=dataclasses.replace(
+            replay,
+            out_dir=moved(replay.out_dir),
+            files=tuple(moved(path) for path in replay.files),
+            manifest={**replay.manifest, "inputs": inputs},
+        ),
+        figure=moved(verdict.figure),
+    )
+
+
+def demo_manifest(
+    verdicts: tuple[ScenarioVerdict, ...], scenario_paths: list[Path], chart: Path, query: Path
+) -> dict[str, object]:
+    """The content of the demo's run.json (each scenario's replay has its own)."""
+    return {
+        **run_header("demo"),
+        "scenarios": [str(path) for path in scenario_paths],
+        "charts": charts_manifest([chart]),
+        "query": str(query),
+        "verdicts": {v.scenario: dict(verdict_rows(v)) for v in verdicts},
+    }
+
+
 def run_demo(
     out_dir: Path | None = None,
     quiet: bool = True,
     scenarios_dir: Path = DEFAULT_SCENARIOS_DIR,
     chart: Path = DEFAULT_CHART,
     query: Path = DEFAULT_QUERY,
+    overwrite: bool = False,
 ) -> DemoResult:
     """Both Greenhopper scenarios: simulate, replay, and the verdicts (module docstring).
 
     Errors: a missing scenario directory, scenario file, chart or query (``InputFileError``,
-    exit 2); a scenario whose replay has no triggered encounter for own ship
-    (``NoDataError``, exit 3).
+    exit 2); an ``out_dir`` that cannot take a report, or holds something other than a
+    colregs9 report and ``overwrite`` is false (``OutputError``, exit 2), both before any
+    work; a scenario whose replay has no triggered encounter for own ship (``NoDataError``,
+    exit 3), which leaves ``out_dir`` as it was.
     """
     target = out_dir if out_dir is not None else DEFAULT_OUT_DIR
     _require(scenarios_dir, "--scenarios", "directory")
@@ -215,5 +264,13 @@ def run_demo(
     paths = [scenarios_dir / f"{name}.toml" for name in SCENARIO_NAMES]
     for path in paths:
         _require(path, "--scenarios", "file")
-    verdicts = tuple(run_scenario(path, target, chart, query, quiet) for path in paths)
+    check_out_dir(target, overwrite)
+    with report_directory(target) as staging:
+        staged = tuple(run_scenario(path, staging, chart, query, quiet) for path in paths)
+        verdicts = tuple(_moved(verdict, staging, target) for verdict in staged)
+        for staged_verdict, verdict in zip(staged, verdicts, strict=True):
+            # Each replay read its AIS in the staging directory; its run.json is to name the
+            # file where it stays, beside the report.
+            write_json(staged_verdict.replay.out_dir / REPORT_MARKER, verdict.replay.manifest)
+        write_json(staging / REPORT_MARKER, demo_manifest(verdicts, paths, chart, query))
     return DemoResult(out_dir=target, verdicts=verdicts)

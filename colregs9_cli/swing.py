@@ -9,7 +9,15 @@ import matplotlib.pyplot as plt
 import pandas as pd
 
 from .manoeuvrability import ManoeuvrabilityParams, reference_vessels
-from .report.atomic import save_figure, write_csv
+from .report.atomic import (
+    REPORT_MARKER,
+    check_out_dir,
+    report_directory,
+    save_figure,
+    write_csv,
+    write_json,
+)
+from .report.manifest import run_header
 from .report.swing_plot import rate_of_swing_figure
 
 DEFAULT_OUT_DIR = Path("reports/swing")
@@ -20,6 +28,7 @@ PNG_NAME = "rate_of_swing.png"
 @dataclass(frozen=True)
 class SwingReport:
     table: pd.DataFrame
+    out_dir: Path
     csv_path: Path
     png_path: Path
     text: str
@@ -32,17 +41,27 @@ def format_swing_table(table: pd.DataFrame) -> str:
     return shown.to_string(index=False) + "\n"
 
 
-def run_swing(out_dir: Path | None = None) -> SwingReport:
-    """Write rate_of_swing.csv and rate_of_swing.png to ``out_dir`` (default reports/swing/)."""
+def run_swing(out_dir: Path | None = None, overwrite: bool = False) -> SwingReport:
+    """Write rate_of_swing.csv, rate_of_swing.png and run.json to ``out_dir`` (default
+    reports/swing/), which is replaced whole as ``stats`` and ``replay`` replace theirs.
+
+    Errors: an ``out_dir`` that cannot take a report, or holds something other than a colregs9
+    report and ``overwrite`` is false (``OutputError``, exit 2), before any work.
+    """
     out_dir = DEFAULT_OUT_DIR if out_dir is None else Path(out_dir)
+    check_out_dir(out_dir, overwrite)
     table = reference_vessels()
-    csv_path = out_dir / CSV_NAME
-    png_path = out_dir / PNG_NAME
-    write_csv(csv_path, table)
     defaults = ManoeuvrabilityParams()
+    # run.json marks the directory as a colregs9 report, which a rerun may then replace.
+    manifest = {**run_header("swing"), "fixed_swing_deg_per_m": defaults.swing_deg_per_m}
     figure = rate_of_swing_figure(table, defaults.swing_deg_per_m)
     try:
-        save_figure(png_path, figure, dpi=150)
+        with report_directory(out_dir) as staging:
+            write_csv(staging / CSV_NAME, table)
+            save_figure(staging / PNG_NAME, figure, dpi=150)
+            write_json(staging / REPORT_MARKER, manifest)
     finally:
         plt.close(figure)
-    return SwingReport(table, csv_path, png_path, format_swing_table(table))
+    return SwingReport(
+        table, out_dir, out_dir / CSV_NAME, out_dir / PNG_NAME, format_swing_table(table)
+    )

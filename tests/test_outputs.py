@@ -139,6 +139,93 @@ def test_every_writer_gives_one_error_line_for_an_out_under_a_file(
         "CHART": str(SANDIEGO_ENC),
     }
     args = [replacements.get(a, a).replace("OUT", str(a_file)) for a in command]
-    result = _invoke(*args, "--quiet") if command[0] != "swing" else _invoke(*args)
+    result = _invoke(*args, "--quiet")
     assert result.exit_code == OutputError.exit_code, result.output
     assert f"lies under {a_file}, which is a file" in _one_error_line(result.output)
+
+
+def _demo(out: Path, *options: str):
+    from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, SCENARIOS
+
+    return _invoke(
+        *("demo", "--out", str(out), "--scenarios", str(SCENARIOS)),
+        *("--chart", str(MODELLED_CHART), "--query", str(GREENHOPPER_QUERY), "--quiet"),
+        *options,
+    )
+
+
+def _swing(out: Path, *options: str):
+    return _invoke("swing", "--out", str(out), "--quiet", *options)
+
+
+@pytest.mark.parametrize("run", [_swing, _demo], ids=["swing", "demo"])
+def test_swing_and_demo_refuse_a_foreign_directory_unless_overwrite(tmp_path: Path, run) -> None:
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "thesis.tex").write_text("precious")
+    refused = run(out)
+    assert refused.exit_code == OutputError.exit_code == 2
+    assert "not a colregs9 report" in _one_error_line(refused.output)
+    assert [p.name for p in out.iterdir()] == ["thesis.tex"]
+    assert [p.name for p in tmp_path.iterdir()] == ["mine"]  # no staging left either
+    replaced = run(out, "--overwrite")
+    assert replaced.exit_code == 0, replaced.output
+    assert not (out / "thesis.tex").exists() and (out / "run.json").is_file()
+
+
+@pytest.mark.parametrize("run", [_swing, _demo], ids=["swing", "demo"])
+def test_swing_and_demo_rerun_into_a_fresh_directory(tmp_path: Path, run) -> None:
+    out = tmp_path / "out"
+    first = run(out)
+    assert first.exit_code == 0, first.output
+    written = sorted(p.relative_to(out) for p in out.rglob("*"))
+    (out / "stale.png").write_text("an earlier run's figure")
+    for scenario_report in (p for p in out.iterdir() if p.is_dir()):  # the demo's replays
+        (scenario_report / "stale.csv").write_text("an earlier run's encounter")
+    again = run(out)  # a colregs9 report: replaced without --overwrite
+    assert again.exit_code == 0, again.output
+    assert sorted(p.relative_to(out) for p in out.rglob("*")) == written
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+def test_the_demo_names_its_files_where_they_are_after_the_swap(tmp_path: Path) -> None:
+    import json
+
+    out = tmp_path / "demo"
+    result = _demo(out)
+    assert result.exit_code == 0, result.output
+    assert ".new" not in result.output
+    for scenario in ("greenhopper_restricted", "greenhopper_not_restricted"):
+        assert str(out / f"{scenario}.png") in result.output
+        manifest = json.loads((out / scenario / "run.json").read_text())
+        (ais,) = manifest["inputs"]
+        assert Path(ais["path"]) == out / f"simulate-{scenario}.csv"
+    assert json.loads((out / "run.json").read_text())["command"] == "demo"
+
+
+@pytest.mark.parametrize(
+    ("command", "notice"),
+    [
+        (["replay", str(NMEA), "--no-plots", "--out", "OUT"], "Reports in OUT"),
+        (["stats", str(DMA26), "--out", "OUT"], "Reports in OUT"),
+        (["swing", "--out", "OUT"], "Reports in OUT"),
+        (["simulate", "SCENARIO", "--out", "OUT/x.csv"], "AIS written to OUT/x.csv"),
+    ],
+    ids=["replay", "stats", "swing", "simulate"],
+)
+def test_the_notice_of_what_was_written_is_on_stderr_and_quiet_drops_it(
+    tmp_path: Path, command: list[str], notice: str
+) -> None:
+    from fixture_files import SCENARIOS
+
+    out = str(tmp_path / "out")
+    scenario = str(SCENARIOS / "greenhopper_restricted.toml")
+    args = [a.replace("OUT", out).replace("SCENARIO", scenario) for a in command]
+    notice = notice.replace("OUT", out)
+    loud = _invoke(*args)
+    assert loud.exit_code == 0, loud.output
+    assert notice in loud.stderr and notice not in loud.stdout
+    assert loud.stdout.strip(), "the results are on stdout"
+    quiet = _invoke(*args, "--quiet")
+    assert quiet.exit_code == 0, quiet.output
+    assert quiet.stderr == "" and quiet.stdout == loud.stdout

@@ -16,13 +16,17 @@ from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
 from colregs9_cli.manoeuvrability import reference_vessels
+from colregs9_cli.report.atomic import is_report
 from colregs9_cli.report.swing_plot import rate_of_swing_figure
 from colregs9_cli.swing import run_swing
 
 
 def test_run_swing_writes_the_table(tmp_path: Path) -> None:
     report = run_swing(tmp_path / "swing")
+    assert report.out_dir == tmp_path / "swing"
     assert report.csv_path == tmp_path / "swing" / "rate_of_swing.csv"
+    # run.json marks the directory as a colregs9 report, which a rerun replaces
+    assert is_report(report.out_dir)
     written = pd.read_csv(report.csv_path)
     assert len(written) == 14
     np.testing.assert_allclose(
