@@ -112,8 +112,17 @@ def write_chart_geopackage(path: Path, chart: Chart, draught_m: float, ukc_m: fl
 class ChartSummary:
     chart: Chart
     navigable_area_km2: float | None
-    plot_path: Path | None
+    plot_path: Path | None  # the plot or the GeoPackage written, if any
     text: str
+
+    @property
+    def written(self) -> str:
+        """The line naming what was written (the CLI's notice on stderr); empty if nothing."""
+        if self.plot_path is None:
+            return ""
+        if self.plot_path.suffix.lower() == GEOPACKAGE_SUFFIX:
+            return f"GeoPackage: {self.plot_path} (layers {', '.join(GEOPACKAGE_LAYERS)})"
+        return f"Plot: {self.plot_path}"
 
 
 def _check_depth(name: str, value: float | None) -> None:
@@ -210,7 +219,6 @@ def summarise_chart(
         text += (
             f"Navigable water for draught {draught_m:g} m + UKC {ukc_m:g} m: {area_km2:.3f} km²\n"
         )
-        text += f"GeoPackage: {out_path} (layers {', '.join(GEOPACKAGE_LAYERS)})\n"
         return ChartSummary(chart, area_km2, out_path, text)
     plot_path = out_path
     figure, ax = plt.subplots(figsize=(8, 8), layout="constrained")
@@ -228,5 +236,4 @@ def summarise_chart(
     finally:
         plt.close(figure)
     text += f"Navigable water for draught {draught_m:g} m + UKC {ukc_m:g} m: {area_km2:.3f} km²\n"
-    text += f"Plot: {plot_path}\n"
     return ChartSummary(chart, area_km2, plot_path, text)

@@ -513,7 +513,7 @@ def chart_command(
         typer.Option(
             "--accept-chart-gaps",
             help="Use an S-57 cell whose update sequence has a gap, as updated up to the gap "
-            "(recorded in run.json).",
+            "(the summary names the missing files).",
         ),
     ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
@@ -536,6 +536,8 @@ def chart_command(
             accept_gaps=accept_chart_gaps,
         )
     typer.echo(summary.text, nl=False)
+    if summary.written and not quiet:
+        typer.echo(summary.written, err=True)
 
 
 @app.command("demo", cls=_Command)

@@ -43,6 +43,15 @@ def test_chart_with_a_draught_prints_the_area_and_draws(tmp_path: Path) -> None:
     # 4.5 m + 0.5 m needs DRVAL1 >= 5 m: the 5 m navigable area of test_chart.
     assert line.endswith(": 10.070 km²")
     assert out.stat().st_size > 10_000
+    assert "Plot:" not in result.output  # --quiet drops the notice
+
+
+def test_the_notice_of_what_was_written_goes_to_stderr(tmp_path: Path) -> None:
+    out = tmp_path / "enc.png"
+    result = _run("chart", str(ENC), "--draught", "5", "--out", str(out))
+    assert result.exit_code == 0, result.output
+    assert result.stderr.strip() == f"Plot: {out}"
+    assert "Plot:" not in result.stdout
 
 
 def _one_error_line(result: object, *fragments: str) -> None:
