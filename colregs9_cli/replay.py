@@ -36,8 +36,8 @@ import dataclasses
 import functools
 import math
 import tempfile
-from collections.abc import Sequence
-from contextlib import ExitStack
+from collections.abc import Iterator, Sequence
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -905,7 +905,7 @@ def run_replay(
         if write:
             check_out_dir(target, overwrite)
         slab_s = params.replay.slab_s
-        with tempfile.TemporaryDirectory(prefix="colregs9-slabs-", dir=scratch_dir) as scratch:
+        with _scratch_directory(scratch_dir) as scratch:
             spill_dir = Path(scratch) / "spill"
             spill_dir.mkdir()
             ais = open_replay_input(
@@ -984,6 +984,21 @@ def run_replay(
                     drawer = dask_drawer(cluster)
                     files = write_replay_reports(result, chart, plots, bar, drawer)
         return dataclasses.replace(result, files=files, text=format_summary(result))
+
+
+@contextmanager
+def _scratch_directory(parent: Path | None) -> Iterator[str]:
+    """A temporary directory for the spilled reports, in ``parent`` (default: the system's)."""
+    try:
+        scratch = tempfile.TemporaryDirectory(prefix="colregs9-slabs-", dir=parent)
+    except OSError as exc:
+        where = f"--scratch {parent}" if parent is not None else "the temporary directory"
+        raise ParameterError(
+            f"{where}: cannot make a scratch directory there ({exc.strerror}); give a "
+            "writable directory with --scratch"
+        ) from None
+    with scratch as path:
+        yield path
 
 
 def _evaluate(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import tempfile
 from pathlib import Path
 
 import pandas as pd
@@ -123,3 +124,19 @@ def test_out_of_range_parameters(tmp_path: Path, option: str, value: str, key: s
     result = _invoke(str(NMEA), option, value, "--out", str(tmp_path))
     assert result.exit_code == 2
     assert key in _one_error_line(result)
+
+
+def test_a_scratch_directory_that_cannot_be_written_is_one_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Root writes anywhere, so the refusal of the file system is simulated.
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "TemporaryDirectory", refuse)
+    result = _invoke(
+        str(NMEA), "--no-plots", "--scratch", str(tmp_path), "--out", str(tmp_path / "r")
+    )
+    assert result.exit_code == 2
+    line = _one_error_line(result)
+    assert f"--scratch {tmp_path}" in line and "Permission denied" in line
