@@ -46,7 +46,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+import warnings
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
@@ -305,17 +307,56 @@ def _object_class(value: Any, path: Path) -> str | None:
     return text if text in _OBJECT_CLASSES else None
 
 
+@contextmanager
+def _gdal_quiet() -> Iterator[None]:
+    """GDAL's warnings (pyogrio passes them on as ``RuntimeWarning``) kept off stderr: a file
+    GDAL cannot read is one ``ChartError``, and what it can read needs no remark."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        yield
+
+
 def _read_layer(path: Path, layer: str | int, **options: str) -> tuple[dict[str, Any], Any]:
     try:
-        meta, _, wkb, field_data = pyogrio.raw.read(path, layer=layer, **options)
-    except (DataSourceError, DataLayerError, FieldError, GeometryError, RuntimeError) as exc:
+        with _gdal_quiet():  # and shapely's about NaN vertices: _check_finite names them
+            meta, _, wkb, field_data = pyogrio.raw.read(path, layer=layer, **options)
+            geometries = shapely.from_wkb(wkb) if wkb is not None else np.empty(0, dtype=object)
+    except (
+        DataSourceError,
+        DataLayerError,
+        FieldError,
+        GeometryError,
+        RuntimeError,
+        shapely.errors.GEOSException,
+    ) as exc:
         raise ChartError(
             f"{path}: cannot read layer {layer} ({_first_line(exc)}); give an S-57 .000, "
             "GeoJSON or GeoPackage chart"
         ) from None
     columns = dict(zip(meta["fields"], field_data, strict=True))
-    geometries = shapely.from_wkb(wkb) if wkb is not None else np.empty(0, dtype=object)
+    _check_finite(geometries, path, layer, columns)
     return {"crs": meta.get("crs"), "columns": columns}, geometries
+
+
+def _check_finite(
+    geometries: NDArray[np.object_], path: Path, layer: str | int, columns: Mapping[str, Any]
+) -> None:
+    """A vertex that is not a finite number (NaN, inf) is an error naming the feature: GEOS
+    cannot build or repair such a geometry."""
+    if len(geometries) == 0:
+        return
+    coordinates, owner = shapely.get_coordinates(geometries, return_index=True)
+    bad = ~np.isfinite(coordinates).all(axis=1)
+    if not bad.any():
+        return
+    feature = int(owner[bad][0])
+    objl = columns.get("OBJL")
+    kind = f" ({objl[feature]})" if objl is not None and objl[feature] is not None else ""
+    x, y = coordinates[bad][0]
+    raise ChartError(
+        f"{path}: layer {layer}, feature {feature + 1}{kind}: the vertex ({x}, {y}) is not a "
+        "finite number; fix or remove that feature"
+    )
 
 
 def _first_line(exc: BaseException) -> str:
@@ -324,7 +365,8 @@ def _first_line(exc: BaseException) -> str:
 
 def _list_layers(path: Path) -> list[str]:
     try:
-        return [str(name) for name, _ in pyogrio.list_layers(path)]
+        with _gdal_quiet():
+            return [str(name) for name, _ in pyogrio.list_layers(path)]
     except (DataSourceError, DataLayerError, RuntimeError) as exc:
         raise ChartError(
             f"{path}: not a chart GDAL can open ({_first_line(exc)}); give an S-57 .000, "
@@ -384,9 +426,10 @@ def _whole_number(value: Any) -> int | None:
 def _dsid_fields(path: Path) -> dict[str, Any]:
     """The DSID record of an S-57 cell (after its updates), or nothing when GDAL has none."""
     try:
-        meta, _, _, values = pyogrio.raw.read(
-            path, layer="DSID", read_geometry=False, **S57_OPEN_OPTIONS
-        )
+        with _gdal_quiet():
+            meta, _, _, values = pyogrio.raw.read(
+                path, layer="DSID", read_geometry=False, **S57_OPEN_OPTIONS
+            )
     except (DataSourceError, DataLayerError, FieldError, RuntimeError):
         return {}
     return {
@@ -683,6 +726,17 @@ def _by_detail(features: Sequence[_Features]) -> list[_Features]:
     return [features[i] for i in order]
 
 
+def _project_file(features: _Features, frame: LocalFrame) -> Any:
+    """A file's features in the frame; a geometry GEOS cannot repair names the file."""
+    try:
+        return _project(features.geometries, frame)
+    except shapely.errors.GEOSException as exc:
+        raise ChartError(
+            f"{features.path}: a feature's geometry cannot be used ({_first_line(exc)}); fix "
+            "its rings (closed, at least three distinct vertices, lon/lat in degrees)"
+        ) from None
+
+
 def _file_coverage(features: _Features, geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
     """A file's coverage in the frame: its M_COVR, else the union of its areas
     (``geometries``: its features in the frame)."""
@@ -700,7 +754,7 @@ def _claimed_by_detail(
 ) -> tuple[list[NDArray[np.object_]], list[Any]]:
     """Each file's projected geometries, cut to where no more detailed file has coverage (a
     coarse cell decides only outside the detailed one), and each file's coverage left."""
-    projected = [_project(f.geometries, frame) for f in features]
+    projected = [_project_file(f, frame) for f in features]
     coverages = [_file_coverage(f, g, frame) for f, g in zip(features, projected, strict=True)]
     if len(features) == 1:
         return projected, coverages

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,7 +20,7 @@ import shapely
 from .chart import CellInfo, Chart, load_chart
 from .errors import OutputError, ParameterError
 from .progress import progress_bar, progress_enabled
-from .report.atomic import atomic_path, save_figure
+from .report.atomic import atomic_path, check_out_file, save_figure
 from .report.chart_plot import draw_chart, geographic_axes
 
 DEFAULT_REPORTS_DIR = Path("reports")
@@ -125,9 +126,24 @@ class ChartSummary:
         return f"Plot: {self.plot_path}"
 
 
-def _check_depth(name: str, value: float | None) -> None:
-    if value is not None and not value >= 0.0:
-        raise ParameterError(f"--{name} {value} m is negative; give a value >= 0")
+# The deepest draught of any ship (the largest tankers draw about 25 m; AIS encodes at most
+# 25.5 m), and the largest under-keel clearance a chart check could ask for.
+MAX_DRAUGHT_M = 30.0
+MAX_UKC_M = 30.0
+
+
+def _check_depth(name: str, value: float | None, limit_m: float) -> None:
+    if value is None:
+        return
+    if not math.isfinite(value):
+        raise ParameterError(f"--{name} {value} m is not a number; give metres in [0, {limit_m:g}]")
+    if value < 0.0:
+        raise ParameterError(f"--{name} {value:g} m is negative; give a value >= 0")
+    if value > limit_m:
+        raise ParameterError(
+            f"--{name} {value:g} m is more than any ship needs ({limit_m:g} m at the most); "
+            f"give metres in [0, {limit_m:g}]"
+        )
 
 
 def format_cell(cell: CellInfo) -> str:
@@ -173,8 +189,9 @@ def format_chart_summary(chart: Chart) -> str:
 def check_chart_out(out: Path | None, draught_m: float | None) -> None:
     """Refuse, before any chart is read, an ``--out`` the command would not write: one
     without ``--draught`` (the plot and the GeoPackage show the water for a draught) or of
-    another kind than a plot or a GeoPackage. Paths that cannot be written are refused when
-    writing (``atomic_path``)."""
+    another kind than a plot or a GeoPackage, or a path that is not a regular file
+    (``check_out_file``). Paths that cannot be written are refused when writing
+    (``atomic_path``)."""
     if out is None:
         return
     if draught_m is None:
@@ -189,6 +206,7 @@ def check_chart_out(out: Path | None, draught_m: float | None) -> None:
             f"write; give FILE.gpkg for a GeoPackage or FILE.png ({', '.join(PLOT_SUFFIXES)}) "
             "for a plot"
         )
+    check_out_file(out)
 
 
 def summarise_chart(
@@ -203,8 +221,8 @@ def summarise_chart(
 
     The plot goes to ``out`` (default ``reports/chart-<first chart's stem>.png``).
     """
-    _check_depth("draught", draught_m)
-    _check_depth("ukc", ukc_m)
+    _check_depth("draught", draught_m, MAX_DRAUGHT_M)
+    _check_depth("ukc", ukc_m, MAX_UKC_M)
     check_chart_out(out, draught_m)
     with progress_bar("Reading charts", 1, progress_enabled(quiet)) as bar:
         chart = load_chart(paths, accept_gaps=accept_gaps)

@@ -22,6 +22,8 @@ T = TypeVar("T")
 
 def read_toml(path: Path) -> dict[str, Any]:
     """Read a TOML file; a missing file or a syntax error becomes one clear error."""
+    if path.is_dir():
+        raise InputFileError(f"{path}: a directory, not a file; give the TOML file")
     if not path.is_file():
         raise InputFileError(f"{path}: no such file; check the path")
     try:
@@ -40,7 +42,7 @@ def _accepts(annotation: Any, value: Any) -> bool:
     if origin in (typing.Union, types.UnionType):
         return any(_accepts(arg, value) for arg in typing.get_args(annotation))
     if origin is typing.Literal:
-        return value in typing.get_args(annotation)
+        return _hashable(value) and value in typing.get_args(annotation)
     if annotation is type(None):
         return value is None
     if annotation is float:
@@ -57,13 +59,40 @@ def _accepts(annotation: Any, value: Any) -> bool:
         return True
     if isinstance(annotation, type):
         if hasattr(annotation, "__members__"):  # an Enum: accept its values
-            return value in {m.value for m in annotation}  # type: ignore[attr-defined]
+            values = {m.value for m in annotation}  # type: ignore[attr-defined]
+            return _hashable(value) and value in values
         return isinstance(value, annotation)
     return True
 
 
 def _hashable(value: Any) -> bool:
     return not isinstance(value, list | dict)
+
+
+def _expected(annotation: Any) -> str:
+    """What a key of this type takes, for messages: "a number", "one of 'a', 'b'", ..."""
+    origin = typing.get_origin(annotation)
+    if origin in (typing.Union, types.UnionType):
+        parts = [_expected(a) for a in typing.get_args(annotation) if a is not type(None)]
+        return " or ".join(parts)
+    if origin is typing.Literal:
+        return "one of " + ", ".join(repr(a) for a in typing.get_args(annotation))
+    if annotation is float:
+        return "a number"
+    if annotation is int:
+        return "an integer"
+    if annotation is str:
+        return "a string"
+    if annotation is bool:
+        return "true or false"
+    if origin in (tuple, list, frozenset, set):
+        arguments = [a for a in typing.get_args(annotation) if a is not Ellipsis]
+        item = _expected(arguments[0]) if len(arguments) == 1 else "a value"
+        return f"a flat list, each item {item}"
+    if isinstance(annotation, type) and hasattr(annotation, "__members__"):
+        values = [repr(m.value) for m in annotation]  # type: ignore[attr-defined]
+        return "one of " + ", ".join(values)
+    return f"a {getattr(annotation, '__name__', annotation)}"
 
 
 def _convert(annotation: Any, value: Any) -> Any:
@@ -82,6 +111,12 @@ def _convert(annotation: Any, value: Any) -> Any:
     if isinstance(annotation, type) and hasattr(annotation, "__members__"):
         return annotation(value)
     return value
+
+
+def _shown(value: Any, limit: int = 80) -> str:
+    """``repr(value)`` cut to one short line."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def dataclass_from_table(cls: type[T], table: dict[str, Any], where: str) -> T:
@@ -104,8 +139,7 @@ def dataclass_from_table(cls: type[T], table: dict[str, Any], where: str) -> T:
         annotation = hints[name]
         if not _accepts(annotation, value):
             raise QueryError(
-                f"{where}: key {name!r} has value {value!r}, which is not a valid "
-                f"{getattr(annotation, '__name__', annotation)}"
+                f"{where}: key {name!r} has value {_shown(value)}; give {_expected(annotation)}"
             )
         values[name] = _convert(annotation, value)
     try:

@@ -20,6 +20,7 @@ geodesic computation to well under a millimetre at 2 nm, anywhere on Earth.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from itertools import pairwise
@@ -163,6 +164,20 @@ def candidate_pairs(
     return candidate_pairs_nd(step, (north_m, east_m), range_m)
 
 
+# The cell keys (step, then the cell in each dimension) must fit an int64.
+_KEY_LIMIT = 2.0**62
+
+
+def _cell_side_m(range_m: float, extents_m: list[float], steps: int) -> float:
+    """The grid's cell side: ``range_m``, doubled until every (step, cell) has a key that fits
+    an int64. A cell wider than the range only brings more pairs to the exact distance test;
+    a very short range over a wide extent would otherwise overflow the keys."""
+    side_m = range_m
+    while steps * math.prod(extent / side_m + 3.0 for extent in extents_m) >= _KEY_LIMIT:
+        side_m *= 2.0
+    return side_m
+
+
 def candidate_pairs_nd(
     step: NDArray[np.int64],
     coordinates: tuple[NDArray[np.float64], ...],
@@ -177,10 +192,16 @@ def candidate_pairs_nd(
     if len(step) == 0:
         empty = np.zeros(0, dtype=np.intp)
         return empty, empty
-    cells = []
-    for values in coordinates:
-        cell = np.floor(values / range_m).astype(np.int64)
-        cells.append(cell - (cell.min() - 1))
+    lows = [float(values.min()) for values in coordinates]
+    side_m = _cell_side_m(
+        range_m,
+        [float(values.max()) - low for values, low in zip(coordinates, lows, strict=True)],
+        int(step.max()) - int(step.min()) + 1,
+    )
+    cells = [
+        np.floor((values - low) / side_m).astype(np.int64) + 1
+        for values, low in zip(coordinates, lows, strict=True)
+    ]
     sizes = [int(cell.max()) + 2 for cell in cells]
     key = step - step.min()
     for cell, size in zip(cells, sizes, strict=True):

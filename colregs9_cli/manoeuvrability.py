@@ -49,6 +49,9 @@ if TYPE_CHECKING:
 ELLIPSE_VERTICES = 32
 # Consecutive projected positions tested together by the coarse distance filter.
 _CHUNK_POINTS = 12
+# The most projected positions per arc (horizon_s / step_s): each is a 33-vertex ellipse
+# tested against the chart, for every target at every assessment (the paper: 180).
+MAX_STEPS_PER_ARC = 10_000
 
 
 class SwingModel(StrEnum):
@@ -126,6 +129,13 @@ class ManoeuvrabilityParams:
             raise ParameterError(
                 f"step_s {self.step_s} s is longer than horizon_s {self.horizon_s} s; "
                 "give a step no longer than the horizon"
+            )
+        positions = self.horizon_s / self.step_s
+        if positions > MAX_STEPS_PER_ARC:
+            raise ParameterError(
+                f"horizon_s {self.horizon_s:g} s / step_s {self.step_s:g} s would project "
+                f"{positions:.3g} positions on each arc, more than {MAX_STEPS_PER_ARC}; give a "
+                "longer step_s or a shorter horizon_s (the paper: 180 s in steps of 1 s)"
             )
         if not (math.isfinite(self.ukc_m) and self.ukc_m >= 0.0):
             raise ParameterError(

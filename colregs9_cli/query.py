@@ -387,6 +387,11 @@ def _polygon_from_file(query_path: Path, relative: Any) -> Polygon | MultiPolygo
     if not isinstance(relative, str):
         raise QueryError(f"{query_path}: [region] polygon_file = {relative!r}; give a path")
     polygon_path = (query_path.parent / relative).resolve()
+    if polygon_path.is_dir():
+        raise InputFileError(
+            f"{query_path}: [region] polygon_file {relative!r} is {polygon_path}, a directory, "
+            "not a file; give a GeoJSON file"
+        )
     if not polygon_path.is_file():
         raise InputFileError(
             f"{query_path}: [region] polygon_file {relative!r}: no such file {polygon_path}"
@@ -444,6 +449,11 @@ def _polygon_from_geojson(geojson: Any, where: str) -> Polygon | MultiPolygon:
     except (ValueError, TypeError, AttributeError, IndexError, KeyError) as exc:
         raise QueryError(f"{where}: cannot build the {kind} ({exc})") from None
     assert isinstance(geometry, Polygon | MultiPolygon)
+    if geometry.is_empty:
+        raise QueryError(
+            f"{where}: the {kind} has no coordinates; give at least one closed ring of "
+            "[longitude, latitude] pairs"
+        )
     return geometry
 
 

@@ -29,6 +29,15 @@ class CourseSource(StrEnum):
 # The most steps one vessel may have in a slab's window: 13 float columns of 8 bytes make a
 # gigabyte per vessel at 1e7.
 MAX_STEPS_PER_SLAB = 1e7
+# A slab holds at least this many steps and lasts at least SLAB_MIN_S: shorter slabs only
+# multiply the work per slab (a fixture of five minutes in slabs of a nanosecond would be
+# billions of slabs). A week is the longest: memory grows with the slab, results do not.
+SLAB_MIN_STEPS = 2
+SLAB_MIN_S = 30.0
+SLAB_MAX_S = 7 * 86_400.0
+# The least candidate range: below a metre the pair search's grid would be finer than any
+# AIS position.
+CANDIDATE_RANGE_MIN_M = 1.0
 
 
 @dataclass(frozen=True)
@@ -118,6 +127,22 @@ class ReplayParams:
             raise ParameterError(
                 f"[replay] max_gap_s = {self.max_gap_s} is shorter than step_s = {self.step_s}; "
                 "give a gap of at least one step"
+            )
+        slab_min_s = max(SLAB_MIN_S, SLAB_MIN_STEPS * self.step_s)
+        if not slab_min_s <= self.slab_s <= SLAB_MAX_S:
+            raise ParameterError(
+                f"[replay] slab_s = {self.slab_s:g} s (--slab-minutes {self.slab_s / 60.0:g}) is "
+                f"outside [{slab_min_s:g}, {SLAB_MAX_S:g}] s; give a slab of at least "
+                f"{SLAB_MIN_S:g} s and {SLAB_MIN_STEPS} steps (step_s = {self.step_s:g} s), and "
+                "at most a week (30 minutes is the default)"
+            )
+        range_min_m = max(CANDIDATE_RANGE_MIN_M, self.cpa_req_m)
+        if self.candidate_range_m < range_min_m:
+            raise ParameterError(
+                f"[replay] candidate_range_m = {self.candidate_range_m:g} m is below "
+                f"{range_min_m:g} m (cpa_req_m = {self.cpa_req_m:g} m, and 1 m at the least); "
+                "a pair must be a candidate before its CPA can trigger: give a range of at least "
+                "that (2 nm, 3704 m, is the default)"
             )
         window_steps = (
             self.slab_s + 2.0 * self.tcpa_act_s + 60.0 + 4.0 * self.max_gap_s

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 from shapely.geometry import LineString, Point
 
+from .ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
 from .chart import Chart, load_chart
 from .config import read_toml
 from .errors import QueryError
@@ -55,6 +56,17 @@ _VESSEL_KEYS = {
     "speed_kn": object,
 }
 _OPTIONAL_VESSEL_KEYS = frozenset({"role", "imo"})
+# A vessel's dimensions are held to what ships have, as AIS input is (``ais.clean``), and her
+# speed to what AIS can report (SOG 102.2 kn; 102.3 means "not available").
+DIMENSION_LIMITS_M = {
+    "length_m": MAX_LENGTH_M,
+    "breadth_m": MAX_BREADTH_M,
+    "draught_m": MAX_DRAUGHT_M,
+}
+MAX_SPEED_KN = 102.2
+# A scenario's times lie in the years AIS data may have (as ingest checks its input).
+TIME_MIN = dt.datetime(1980, 1, 1, tzinfo=dt.UTC)
+TIME_END = dt.datetime(2100, 1, 1, tzinfo=dt.UTC)
 
 
 class VesselRole(StrEnum):
@@ -124,7 +136,13 @@ def _typed(value: Any, kind: type, where: str, key: str) -> Any:
                 f"{where}: key {key!r} = {value!r} is not a UTC date-time; "
                 "write it like 2024-09-09T12:00:00Z"
             )
-        return value.astimezone(dt.UTC)
+        try:
+            return value.astimezone(dt.UTC)
+        except OverflowError:
+            raise QueryError(
+                f"{where}: key {key!r} = {value.isoformat()} is beyond the range of times; "
+                "give a time between 1980 and 2099"
+            ) from None
     if not isinstance(value, kind):
         raise QueryError(f"{where}: key {key!r} = {value!r} is not a {kind.__name__}")
     return value
@@ -183,6 +201,11 @@ def _speeds(value: Any, legs: int, where: str) -> tuple[float, ...]:
             "give one speed per leg or one number for all"
         )
     for leg, speed in enumerate(speeds):
+        if speed > MAX_SPEED_KN:
+            raise QueryError(
+                f"{where}: speed_kn = {speed:g} on leg {leg} (waypoint {leg} to {leg + 1}) is "
+                f"more than AIS can report ({MAX_SPEED_KN:g} kn); give a ship's speed in knots"
+            )
         if speed <= 0.0:
             raise QueryError(
                 f"{where}: speed_kn = {speed!r} on leg {leg} (waypoint {leg} to {leg + 1}) "
@@ -208,8 +231,13 @@ def _vessel(table: Any, index: int, source: Path) -> VesselSpec:
         raise QueryError(f"{where}: key 'role' = {role_text!r}; give 'own' or 'target'")
     if not 100_000_000 <= values["mmsi"] <= 999_999_999:
         raise QueryError(f"{where}: key 'mmsi' = {values['mmsi']!r} is not a 9-digit MMSI")
-    for key in ("length_m", "breadth_m", "draught_m"):
+    for key, limit_m in DIMENSION_LIMITS_M.items():
         _positive(values[key], where, key)
+        if values[key] > limit_m:
+            raise QueryError(
+                f"{where}: key {key!r} = {values[key]:g} m is more than any ship has "
+                f"({limit_m:g} m at the most); give a plausible {key.split('_')[0]}"
+            )
     if not 0 <= values["nav_status"] <= 15:
         raise QueryError(
             f"{where}: key 'nav_status' = {values['nav_status']!r}; give an ITU code 0–15"
@@ -258,6 +286,15 @@ def load_scenario(path: Path) -> Scenario:
             f"{where}: duration_s / step_s = {steps:.3g} integration steps, more than "
             f"{MAX_SCENARIO_STEPS:.0e}; give a shorter duration_s or a longer step_s"
         )
+    start = values["start_utc"]
+    if TIME_MIN <= start < TIME_END:  # then the end cannot overflow
+        end = start + dt.timedelta(seconds=min(values["duration_s"], 200 * 365.25 * 86_400.0))
+    if not (TIME_MIN <= start < TIME_END and end < TIME_END):
+        raise QueryError(
+            f"{where}: start_utc = {start.isoformat()} and duration_s = "
+            f"{values['duration_s']:g} run outside the years 1980 to 2099; give a start_utc "
+            "(and duration) within them"
+        )
     ratio = values["ais_interval_s"] / values["step_s"]
     if ratio < 1.0 - 1e-9:
         raise QueryError(
@@ -279,6 +316,11 @@ def load_scenario(path: Path) -> Scenario:
     if sum(v.role is VesselRole.OWN for v in vessels) > 1:
         raise QueryError(f"{where}: more than one vessel has role = 'own'; give at most one")
     chart = (path.parent / values["chart"]).resolve() if "chart" in values else None
+    if chart is not None and chart.exists() and not chart.is_file():
+        raise QueryError(
+            f"{where}: chart = {values['chart']!r} is {chart}, a directory, not a file; give "
+            "the chart file (S-57 .000, GeoJSON or GeoPackage)"
+        )
     return Scenario(
         name=values["name"],
         description=values["description"],

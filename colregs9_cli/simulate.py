@@ -28,7 +28,7 @@ import pandas as pd
 from .ais.schema import NAV_STATUS_CODES
 from .geo import LocalFrame
 from .progress import progress_bar, progress_enabled
-from .report.atomic import write_csv
+from .report.atomic import check_out_file, write_csv
 from .scenario import (
     Scenario,
     VesselSpec,
@@ -214,6 +214,8 @@ def default_out_path(scenario: Scenario) -> Path:
 def simulate_scenario(path: Path, out: Path | None = None, quiet: bool = True) -> SimulationResult:
     """Load, check and simulate a scenario; write its AIS as DMA CSV (time-ordered)."""
     scenario = load_scenario(path)
+    target = out if out is not None else default_out_path(scenario)
+    check_out_file(target)
     check_scenario_chart(scenario)
     tracks = simulate(scenario, quiet=quiet)
     rows = pd.concat([dma_rows(t, scenario.start_utc) for t in tracks], ignore_index=True)
@@ -221,6 +223,5 @@ def simulate_scenario(path: Path, out: Path | None = None, quiet: bool = True) -
         (rows["MMSI"].astype(np.int64).to_numpy(), np.concatenate([t.time_s for t in tracks]))
     )
     rows = rows.iloc[order].reset_index(drop=True)
-    target = out if out is not None else default_out_path(scenario)
     write_csv(target, rows)
     return SimulationResult(scenario=scenario, out_path=target, tracks=tracks, rows=len(rows))

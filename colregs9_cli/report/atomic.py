@@ -9,6 +9,7 @@ import json
 import os
 import secrets
 import shutil
+import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -19,6 +20,41 @@ import pandas as pd
 from ..errors import OutputError
 
 
+def _kind(path: Path) -> str:
+    """What a path that is not a regular file is, for messages."""
+    mode = path.stat().st_mode
+    for test, name in (
+        (stat.S_ISDIR, "a directory"),
+        (stat.S_ISFIFO, "a named pipe (FIFO)"),
+        (stat.S_ISCHR, "a character device"),
+        (stat.S_ISBLK, "a block device"),
+        (stat.S_ISSOCK, "a socket"),
+    ):
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
+def check_out_file(target: Path) -> None:
+    """Refuse, before any work, an ``--out`` file that cannot take the output: one under a
+    file, or an existing path that is not a regular file (a directory, a FIFO, a device: the
+    output would replace it by a regular file). An existing regular file is replaced."""
+    existing = target.parent
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise OutputError(f"{target}: lies under {existing}, which is a file; give another --out")
+    try:
+        present = target.exists()
+        kind = _kind(target) if present and not target.is_file() else ""
+    except OSError as exc:
+        raise _output_error(target, exc) from None
+    if kind:
+        raise OutputError(
+            f"{target}: --out is {kind}, not a regular file; give the path of a file to write"
+        )
+
+
 @contextmanager
 def atomic_path(target: Path, suffix: str = ".tmp") -> Iterator[Path]:
     """Yield a temporary path in the target's directory; rename it to ``target`` on success.
@@ -27,14 +63,8 @@ def atomic_path(target: Path, suffix: str = ".tmp") -> Iterator[Path]:
     the target itself (``tempfile.mkstemp`` would make it 0600 whatever the umask). ``suffix``
     ends its name, for writers that go by it (GDAL wants ``.gpkg``).
     """
-    existing = target.parent
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
-    if existing.exists() and not existing.is_dir():
-        raise OutputError(f"{target}: lies under {existing}, which is a file; give another --out")
+    check_out_file(target)
     try:
-        if target.is_dir():
-            raise IsADirectoryError(21, "a directory is in the way", str(target))
         target.parent.mkdir(parents=True, exist_ok=True)
         tmp = _new_file(target.parent, f".{target.name}.", suffix)
     except OSError as exc:
