@@ -24,12 +24,20 @@ QUIET_HELP = (
 OVERWRITE_HELP = "Replace an --out directory that holds something other than a colregs9 report."
 # What every AIS reader takes (ais/sources.py tells the compression from the first bytes).
 AIS_FILES_HELP = (
-    "AIS files: DMA CSV (22 or 26 columns), MarineCadastre CSV, raw NMEA or canonical Parquet; "
-    "plain or compressed (gzip, bzip2, xz, zstd, or a zip holding one file)"
+    "AIS files: DMA CSV (22 or 26 columns), MarineCadastre CSV (2015 on), exactEarth/Spire CSV, "
+    "any CSV with --columns, raw NMEA or canonical Parquet; plain or compressed (gzip, bzip2, "
+    "xz, zstd, or a zip holding one file)"
 )
 DATASETS_HELP = "; or dataset directories made by colregs9 ingest."
 # The values of ais.detect.LAYOUTS, written out: importing it would load pyarrow for --help.
-LAYOUT_HELP = "Input layout instead of detecting it: dma26, dma22, marinecadastre, nmea, parquet."
+LAYOUT_HELP = (
+    "Input layout instead of detecting it: dma26, dma22, marinecadastre, marinecadastre2015, "
+    "marinecadastre2025, exactearth, nmea, parquet. Needed for a CSV without its header."
+)
+COLUMNS_HELP = (
+    "Column map (TOML) for any other CSV: source column -> canonical column, time format, "
+    "units, sentinels (README: Column maps)."
+)
 # What chart.py reads, told by the suffix.
 CHART_FORMATS = (
     "S-57 base cell .000 (with its updates .001, .002 … beside it), GeoJSON (.geojson, .json) "
@@ -72,6 +80,19 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
     rich_markup_mode=None,
 )
+
+
+def _input_format(fmt: str | None, columns: Path | None) -> str | None:
+    """The layout given by --format, or the one that stands for --columns MAP.toml."""
+    if columns is None:
+        return fmt
+    from .errors import ParameterError
+
+    if fmt is not None:
+        raise ParameterError(f"--format {fmt} and --columns {columns}: give one of them, not both")
+    from .ais.column_map import map_layout
+
+    return map_layout(columns)
 
 
 @contextmanager
@@ -153,6 +174,10 @@ def replay_command(
             metavar="LAYOUT",
             help=LAYOUT_HELP,
         ),
+    ] = None,
+    columns: Annotated[
+        Path | None,
+        typer.Option("--columns", metavar="MAP.toml", help=COLUMNS_HELP),
     ] = None,
     step_s: Annotated[
         float | None, typer.Option("--step-s", metavar="S", help="Replay time step Δt (s); 1.")
@@ -247,6 +272,7 @@ def replay_command(
     from .replay import run_replay
 
     with _user_errors():
+        fmt = _input_format(fmt, columns)
         result = run_replay(
             ais,
             chart_paths=chart or [],
@@ -354,6 +380,10 @@ def stats_command(
             help=LAYOUT_HELP,
         ),
     ] = None,
+    columns: Annotated[
+        Path | None,
+        typer.Option("--columns", metavar="MAP.toml", help=COLUMNS_HELP),
+    ] = None,
     out: Annotated[
         Path | None,
         typer.Option(
@@ -380,6 +410,7 @@ def stats_command(
     from .stats import run_stats
 
     with _user_errors():
+        fmt = _input_format(fmt, columns)
         result = run_stats(
             ais,
             query_path=query,
@@ -429,6 +460,10 @@ def ingest_command(
             help=LAYOUT_HELP,
         ),
     ] = None,
+    columns: Annotated[
+        Path | None,
+        typer.Option("--columns", metavar="MAP.toml", help=COLUMNS_HELP),
+    ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
     """Clean AIS files into a Parquet dataset partitioned by date, for stats and replay.
@@ -446,6 +481,7 @@ def ingest_command(
     from .ais.dataset import ingest
 
     with _user_errors():
+        fmt = _input_format(fmt, columns)
         result = ingest(ais, out, query_path=query, fmt=fmt, quiet=quiet)
     typer.echo(result.text, nl=False)
 

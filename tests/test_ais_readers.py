@@ -244,7 +244,9 @@ def test_unknown_layout(tmp_path: Path) -> None:
         load_ais([path])
     message = str(caught.value)
     assert "other.csv: unknown AIS layout" in message and "'ship,when,where'" in message
-    assert "dma26, dma22, marinecadastre, nmea, parquet" in message and "--format" in message
+    layouts = "dma26, dma22, marinecadastre, marinecadastre2015, marinecadastre2025, exactearth"
+    assert f"{layouts}, nmea, parquet" in message and "--format" in message
+    assert "--columns MAP.toml" in message
 
 
 def test_truncated_gzip_csv_and_nmea(tmp_path: Path) -> None:

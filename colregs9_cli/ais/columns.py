@@ -1,4 +1,5 @@
-"""The columns each CSV layout reads, and how they are read.
+"""The columns each CSV layout reads, and how they are read (DMA here; the others by their
+column maps, column_map.py).
 
 A light module (no ``pyarrow.compute``, pandas or shapely): ``colregs9 stats`` starts reading
 its first CSV before it imports those (``csv_read.start_reading``).
@@ -8,7 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .detect import DMA22_COLUMNS, MARINECADASTRE_COLUMNS
+from .column_map import ColumnMap, column_map
+from .detect import DMA22_COLUMNS
 
 # -- DMA "aisdk" (lower-case names) -------------------------------------------------------------
 
@@ -58,33 +60,6 @@ def dma_dimension_columns(has_abcd: bool) -> tuple[str, ...]:
     return (*dimensions, *DMA_ABCD) if has_abcd else dimensions
 
 
-# -- MarineCadastre (lower-case names) --------------------------------------------------------
-
-MARINECADASTRE_UNREAD_COLUMNS = ("cargo",)
-MARINECADASTRE_READ_COLUMNS = tuple(
-    c for c in MARINECADASTRE_COLUMNS if c not in MARINECADASTRE_UNREAD_COLUMNS
-)
-# Converted for every row.
-MARINECADASTRE_ROW_COLUMNS = ("mmsi", "lat", "lon", "transceiverclass", "length", "width", "draft")
-MARINECADASTRE_NUMERIC_COLUMNS = (
-    "mmsi",
-    "lat",
-    "lon",
-    "sog",
-    "cog",
-    "heading",
-    "vesseltype",
-    "status",
-    "length",
-    "width",
-    "draft",
-)
-# MarineCadastre writes its dimensions as decimals ("208.0").
-MARINECADASTRE_WHOLE_COLUMNS = ("mmsi",)
-MARINECADASTRE_DIMENSION_COLUMNS = ("length", "width", "draft")
-MARINECADASTRE_STATIC_TEXT_COLUMNS = ("vesselname", "callsign", "imo")
-
-
 @dataclass(frozen=True)
 class CsvColumns:
     """What the chunk reader converts: ``row_columns`` for every row, ``columns`` for the
@@ -94,9 +69,11 @@ class CsvColumns:
     row_columns: tuple[str, ...]
     numeric: tuple[str, ...]
     whole: tuple[str, ...]
+    delimiter: str = ","
 
 
-def csv_columns(layout: str) -> CsvColumns:
+def csv_columns(layout: str, header: tuple[str, ...] = ()) -> CsvColumns:
+    """The columns of ``layout`` read from a file with the columns ``header``."""
     if layout in ("dma26", "dma22"):
         abcd = layout == "dma26"
 
@@ -109,9 +86,25 @@ def csv_columns(layout: str) -> CsvColumns:
             present(DMA_NUMERIC_COLUMNS),
             present(DMA_WHOLE_COLUMNS),
         )
+    return map_columns(file_map(layout, header))
+
+
+def file_map(layout: str, header: tuple[str, ...]) -> ColumnMap:
+    """The column map of ``layout`` for a file with the columns ``header`` (its aliases
+    resolved, column_map.py)."""
+    map_ = column_map(layout)
+    if map_ is None:
+        raise ValueError(f"{layout!r} is not a mapped CSV layout")
+    return map_.for_header(header)
+
+
+def map_columns(map_: ColumnMap) -> CsvColumns:
+    """What the chunk reader converts for a column map (column_map.py): the mapped columns,
+    the MMSI, position, class and dimensions for every row."""
     return CsvColumns(
-        MARINECADASTRE_READ_COLUMNS,
-        MARINECADASTRE_ROW_COLUMNS,
-        MARINECADASTRE_NUMERIC_COLUMNS,
-        MARINECADASTRE_WHOLE_COLUMNS,
+        map_.read_columns,
+        map_.row_columns,
+        map_.numeric_columns,
+        map_.whole_columns,
+        map_.delimiter,
     )

@@ -254,6 +254,7 @@ class _Layout:
     all_columns: Sequence[str]
     numeric: frozenset[str]
     whole: frozenset[str]
+    delimiter: str = ","
 
 
 def read_chunks(
@@ -264,6 +265,7 @@ def read_chunks(
     all_columns: Sequence[str],
     numeric: Sequence[str],
     whole: Sequence[str] = (),
+    delimiter: str = ",",
 ) -> Generator[CsvChunk, None, None]:
     """The chunks of a CSV stream, in order, each parsed on a worker thread while the ones
     before it are used.
@@ -273,7 +275,9 @@ def read_chunks(
     can be, those also in ``whole`` as integers. Raises ``pa.ArrowInvalid`` for data
     pyarrow cannot read, ``NotUtf8``, and whatever reading the stream raises.
     """
-    layout = _Layout(names, row_columns, all_columns, frozenset(numeric), frozenset(whole))
+    layout = _Layout(
+        names, row_columns, all_columns, frozenset(numeric), frozenset(whole), delimiter
+    )
     pieces = _Pieces(stream, first_line=2 if has_header else 1, skip_header=has_header)
     workers = parse_workers()
     with ThreadPoolExecutor(max_workers=workers, thread_name_prefix="colregs9-csv") as pool:
@@ -419,7 +423,9 @@ def _parse_numbers_or_text(
 
         types = {c: _type(c, layout, text) for c in columns}
         try:
-            table = _parse(data, layout.names, types, threads, invalid_row, block_bytes)
+            table = _parse(
+                data, layout.names, types, threads, invalid_row, block_bytes, layout.delimiter
+            )
         except pa.ArrowInvalid as exc:
             if "straddles" in str(exc) and block_bytes <= len(data):
                 block_bytes = len(data) + 1  # a line longer than a block: one block
@@ -473,13 +479,14 @@ def _parse(
     threads: bool,
     invalid_row: Any = None,
     block_bytes: int = PARSE_BLOCK_BYTES,
+    delimiter: str = ",",
 ) -> pa.Table:
     return pacsv.read_csv(
         pa.BufferReader(pa.py_buffer(data)),
         read_options=pacsv.ReadOptions(
             column_names=list(names), block_size=block_bytes, use_threads=threads
         ),
-        parse_options=pacsv.ParseOptions(invalid_row_handler=invalid_row),
+        parse_options=pacsv.ParseOptions(delimiter=delimiter, invalid_row_handler=invalid_row),
         convert_options=pacsv.ConvertOptions(
             column_types=dict(types),
             include_columns=list(types),

@@ -20,9 +20,9 @@ from types import TracebackType
 
 from ..errors import Colregs9Error
 from ..progress import ProgressSink
-from .columns import csv_columns
+from .columns import csv_columns, file_map
 from .csv_chunks import CsvChunk, read_chunks
-from .detect import CSV_LAYOUTS, CsvHeader, csv_header, detect_layout
+from .detect import CsvHeader, csv_header, detect_layout, is_csv_layout
 from .sources import OpenedData, Source, inspect_source, open_data, read_head
 
 # How many parsed chunks may wait for the caller (about 25 MB each, bytes and row columns).
@@ -87,12 +87,13 @@ class CsvReading:
         """``progress`` None: report to the bar given later (``attach_progress``)."""
         self.source = source
         self.layout = layout
+        self.header = header
         self._exits = contextlib.ExitStack()
         self._progress = _LateProgress()
         if progress is not None:
             self._progress.attach(progress)
         self._opened: OpenedData = self._exits.enter_context(open_data(source, self._progress))
-        columns = csv_columns(layout)
+        columns = csv_columns(layout, header.columns)
         self._chunks = read_chunks(
             self._opened.stream,
             header.columns,
@@ -101,6 +102,7 @@ class CsvReading:
             all_columns=columns.columns,
             numeric=columns.numeric,
             whole=columns.whole,
+            delimiter=columns.delimiter,
         )
         self._exits.callback(self._chunks.close)
         self._queue: queue.Queue[object] | None = None
@@ -174,7 +176,9 @@ class CsvReading:
 
 def missing_columns(layout: str, header: CsvHeader) -> list[str]:
     """The columns the layout reads that the header lacks, in the layout's order."""
-    return [c for c in csv_columns(layout).columns if c not in header.columns]
+    if layout in ("dma26", "dma22"):
+        return [c for c in csv_columns(layout).columns if c not in header.columns]
+    return file_map(layout, header.columns).missing(header.columns)
 
 
 @contextlib.contextmanager
@@ -187,7 +191,7 @@ def start_reading(paths: Sequence[Path], fmt: str | None) -> Iterator[CsvReading
         if source is not None:
             head = read_head(source)
             layout = fmt if fmt is not None else detect_layout(source, head)
-            header = csv_header(head, layout) if layout in CSV_LAYOUTS else None
+            header = csv_header(source, head, layout) if is_csv_layout(layout) else None
             if header is not None and not missing_columns(layout, header):
                 reading = CsvReading(source, layout, header, None, ahead=True)
     if reading is None:

@@ -71,9 +71,8 @@ from .dataset_scan import (
     read_manifest,
     utc_ms,
 )
-from .detect import LAYOUTS
 from .ledger import RejectReason, RejectsLedger
-from .load import ingest_params, rows_in_query, scan_columns, stream_ais
+from .load import check_format, ingest_params, rows_in_query, scan_columns, stream_ais
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from .sources import Source, inspect_source, sha256_file
 
@@ -147,8 +146,7 @@ def ingest_with_query(
     row_group_rows: int = ROW_GROUP_ROWS,
 ) -> IngestResult:
     """``ingest`` with the query already loaded (replay ingests its files this way)."""
-    if fmt is not None and fmt not in LAYOUTS:
-        raise ParameterError(f"--format {fmt!r} is not a layout; use one of {', '.join(LAYOUTS)}")
+    check_format(fmt)
     if row_group_rows < 1:
         raise ParameterError(f"row_group_rows {row_group_rows}: give 1 or more")
     if not paths:

@@ -70,7 +70,7 @@ import pyarrow.compute as pc
 from ..errors import InputFileError, NoDataError, ParameterError
 from ..progress import ProgressSink, progress_bar, progress_enabled
 from ..query import Query, everything_query
-from . import dma, marinecadastre
+from . import dma, mapped
 from .batch import AisBatch
 from .clean import (
     DimensionColumns,
@@ -84,9 +84,11 @@ from .clean import (
     to_numpy_float,
     valid_mmsi,
 )
+from .column_map import MAP_PREFIX
+from .columns import file_map
 from .csv_chunks import CsvChunk, CutRows, NotUtf8, ParsedRows, parse_cut_rows
 from .csv_read import CsvReading, missing_columns
-from .detect import CSV_LAYOUTS, LAYOUTS, csv_header, detect_layout
+from .detect import LAYOUTS, csv_header, detect_layout, is_csv_layout, known_layout
 from .ledger import RejectReason, RejectsLedger
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from .sources import (
@@ -180,8 +182,7 @@ def load_ais(
     """
     query = query if query is not None else everything_query()
     ingest_params(query)
-    if fmt is not None and fmt not in LAYOUTS:
-        raise ParameterError(f"--format {fmt!r} is not a layout; use one of {', '.join(LAYOUTS)}")
+    check_format(fmt)
     if not paths:
         raise InputFileError("no AIS input files given; name at least one file")
     wanted = list(CANONICAL_COLUMNS if columns is None else columns)
@@ -614,18 +615,27 @@ def _read_source(
         return _read_parquet(source, query, bar, sink)
     if layout == "nmea":
         return _read_nmea(source, query, bar, sink)
-    if layout not in CSV_LAYOUTS:
-        raise ParameterError(
-            f"--format {layout!r} is not a layout; use one of {', '.join(LAYOUTS)}"
-        )
-    header = csv_header(head, layout)
+    if not is_csv_layout(layout):
+        check_format(layout)
+    header = csv_header(source, head, layout)
     missing = missing_columns(layout, header)
     if missing:
+        if layout.startswith(MAP_PREFIX):
+            raise InputFileError(
+                f"{source.name}: the map {layout[len(MAP_PREFIX) :]} names the column "
+                f"{missing[0]!r}, which the header does not have; check the map's [columns]"
+            )
         raise InputFileError(
             f"{source.name}: the {layout} layout needs the column {missing[0]!r}, which the "
             f"header does not have; check the file or the --format given"
         )
     return _read_csv(source, layout, query, CsvReading(source, layout, header, bar), sink)
+
+
+def check_format(fmt: str | None) -> None:
+    """``ParameterError`` unless ``fmt`` is None, a layout or a column map (``columns:``)."""
+    if fmt is not None and not known_layout(fmt):
+        raise ParameterError(f"--format {fmt!r} is not a layout; use one of {', '.join(LAYOUTS)}")
 
 
 @dataclass(frozen=True)
@@ -634,9 +644,11 @@ class _CsvLayout:
     static_text: _StaticText
     canonical: Callable[[pa.RecordBatch], tuple[pa.Table, np.ndarray]]
     example_columns: dict[str, str]  # what -> the column to quote in reject examples
+    # Rows of AIS message types that are neither positions, statics nor non-vessels.
+    unsupported: Callable[[pa.RecordBatch], np.ndarray | None] = lambda _: None
 
 
-def _csv_layout(layout: str) -> _CsvLayout:
+def _csv_layout(layout: str, header: tuple[str, ...]) -> _CsvLayout:
     if layout in ("dma26", "dma22"):
         abcd = layout == "dma26"
         return _CsvLayout(
@@ -651,24 +663,31 @@ def _csv_layout(layout: str) -> _CsvLayout:
                 "time": "timestamp",
             },
         )
+    map_ = file_map(layout, header)
+    mobile = next(
+        (map_.column(t) for t in ("message_type", "mobile_type") if map_.has(t)),
+        map_.column("mmsi"),
+    )
     return _CsvLayout(
-        fields=marinecadastre.marinecadastre_fields,
-        static_text=marinecadastre.marinecadastre_static_text,
-        canonical=marinecadastre.marinecadastre_canonical,
+        fields=lambda b: mapped.mapped_fields(map_, b),
+        static_text=lambda b: mapped.mapped_static_text(map_, b),
+        canonical=lambda b: mapped.mapped_canonical(map_, b),
         example_columns={
-            "MMSI": "mmsi",
-            "latitude": "lat",
-            "longitude": "lon",
-            "mobile": "transceiverclass",
-            "time": "basedatetime",
+            "MMSI": map_.column("mmsi"),
+            "latitude": map_.column("lat_deg"),
+            "longitude": map_.column("lon_deg"),
+            "mobile": mobile,
+            "message": map_.column("message_type") if map_.has("message_type") else mobile,
+            "time": map_.column("timestamp"),
         },
+        unsupported=lambda b: mapped.unsupported_messages(map_, b),
     )
 
 
 def _read_csv(
     source: Source, layout: str, query: Query, reading: CsvReading, sink: RowSink | None
 ) -> _FileResult:
-    spec = _csv_layout(layout)
+    spec = _csv_layout(layout, reading.header.columns)
     conversion = _Conversion(_csv_conversion(source.name, spec), spec.canonical, spec.static_text)
     result = _FileResult(query, source.name, conversion, layout=layout, sink=sink)
     with reading:
@@ -720,7 +739,7 @@ def _csv_chunk(result: _FileResult, spec: _CsvLayout, chunk: CsvChunk) -> None:
             value = chunk.take(np.array([row]), [column]).column(column)[0].as_py()
         return _line_example(result.name, chunk.line_of(row), why, value)
 
-    _classify(result, spec.fields(rows), chunk.cut, example)
+    _classify(result, spec.fields(rows), chunk.cut, example, spec.unsupported(rows))
 
 
 def _line_example(name: str, line: int, why: str, value: object) -> str:
@@ -751,12 +770,18 @@ def _cut_example(name: str, spec: _CsvLayout, rows: ParsedRows) -> Example:
 
 
 def _classify(
-    result: _FileResult, fields: Fields, cut: Callable[[np.ndarray], _Part], example: Example
+    result: _FileResult,
+    fields: Fields,
+    cut: Callable[[np.ndarray], _Part],
+    example: Example,
+    unsupported: np.ndarray | None = None,
 ) -> None:
     """Account every row of one block (see the module docstring) and set aside the rows
     whose other columns decide the rest (``_FileResult.settle``).
 
-    ``cut(rows)`` gives those rows of the block, to be converted later.
+    ``cut(rows)`` gives those rows of the block, to be converted later. ``unsupported``:
+    rows of AIS message types that are neither positions nor statics (a CSV of decoded
+    messages), rejected as such after the unparseable rows.
     """
     ledger = result.ledger
     query = result.query
@@ -775,6 +800,10 @@ def _classify(
         what = fields.problem[first]
         reject(unparseable, RejectReason.UNPARSEABLE, what, f"{what} is not a number:")
     left &= ~unparseable
+    if unsupported is not None:
+        unsupported = left & unsupported
+        reject(unsupported, RejectReason.UNSUPPORTED_MESSAGE, "message", "message type")
+        left &= ~unsupported
     not_vessel = left & ~fields.vessel
     reject(not_vessel, RejectReason.NOT_A_VESSEL, "mobile", "mobile type")
     left &= ~not_vessel
