@@ -49,7 +49,7 @@ def vessel_stats(
             f"{exc}; per is one of {[p.value for p in Per]}, by one of "
             f"{[b.value for b in GroupBy]} or None"
         ) from None
-    data = load_ais([Path(p) for p in paths], query=selected)
+    data = load_ais([Path(p) for p in paths], query=selected, needs_time=False)
     return dimension_stats(
         data.positions, data.dimension_reports, per=per_choice, by=by_choice
     ).to_frame()

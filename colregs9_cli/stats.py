@@ -84,6 +84,7 @@ def run_stats(
             started=started,
             columns=POSITION_COLUMNS,
             ordered=False,
+            needs_time=False,
         )
     result = dimension_stats(data.positions, data.dimension_reports, per=per, by=by)
     manifest = build_manifest(result, query, data)

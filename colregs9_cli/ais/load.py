@@ -166,6 +166,7 @@ def load_ais(
     started: CsvReading | None = None,
     columns: Sequence[str] | None = None,
     ordered: bool = True,
+    needs_time: bool = True,
 ) -> AisData:
     """Read AIS files (any mix of layouts) through ``query`` into cleaned positions.
 
@@ -176,7 +177,9 @@ def load_ais(
     of ``positions`` (default: all, ``CANONICAL_COLUMNS``); a dataset read alone decodes
     only these and those the query tests (``_dataset_alone``). ``ordered``: the positions
     sorted by MMSI and time; a caller that needs no order (``stats``) saves the sort of a
-    dataset read alone. Raises ``InputFileError``
+    dataset read alone. ``needs_time`` False (``stats``): NMEA messages without a time are
+    kept, with a null timestamp (outside any time window), and counted under the time source
+    ``none``; otherwise a log in which no message has a time is refused. Raises ``InputFileError``
     for unreadable files, ``NoDataError`` (exit code 3) when no position row is left in the
     query.
     """
@@ -201,7 +204,9 @@ def load_ais(
             if not isinstance(source, Source):
                 inputs.extend(_read_dataset(source, query, scanned, ledger, collected, bar))
                 continue
-            part = _read_source(source, fmt, query, bar, started if index == 0 else None)
+            part = _read_source(
+                source, fmt, query, bar, started if index == 0 else None, needs_time=needs_time
+            )
             ledger.merge(part.ledger)
             collected.extend(part)
             inputs.append(InputFile(source.path, part.sha256, part.layout, part.ledger.rows_read))
@@ -605,6 +610,7 @@ def _read_source(
     bar: ProgressSink,
     started: CsvReading | None,
     sink: RowSink | None = None,
+    needs_time: bool = True,
 ) -> _FileResult:
     if started is not None:
         started.attach_progress(bar)
@@ -614,7 +620,7 @@ def _read_source(
     if layout == "parquet":
         return _read_parquet(source, query, bar, sink)
     if layout == "nmea":
-        return _read_nmea(source, query, bar, sink)
+        return _read_nmea(source, query, bar, sink, needs_time)
     if not is_csv_layout(layout):
         check_format(layout)
     header = csv_header(source, head, layout)
@@ -869,8 +875,10 @@ def _in_query(table: pa.Table, query: Query) -> np.ndarray:
     keep = np.ones(table.num_rows, dtype=bool)
     window = query.time
     if not window.unbounded:
-        # the schema's unit: milliseconds since the epoch
-        milliseconds = table.column("timestamp").cast(pa.int64()).to_numpy()
+        # the schema's unit: milliseconds since the epoch; a row without a time (NaN: an
+        # NMEA message read by stats) is outside any window
+        stamps = table.column("timestamp").cast(pa.int64())
+        milliseconds = to_numpy_float(stamps) if stamps.null_count else stamps.to_numpy()
         if window.start is not None:
             keep &= milliseconds >= round(window.start.timestamp() * 1000)
         if window.end is not None:
@@ -953,26 +961,60 @@ def ingest_params(query: Query) -> IngestParams:
 
 
 def _read_nmea(
-    source: Source, query: Query, bar: ProgressSink, sink: RowSink | None
+    source: Source, query: Query, bar: ProgressSink, sink: RowSink | None, needs_time: bool
 ) -> _FileResult:
-    from .nmea import read_nmea
+    """An NMEA log; with ``needs_time`` False its messages without a time are kept (a null
+    timestamp is then no time, not a bad one), else a log where none has a time is refused."""
+    from .nmea import NmeaCounts, read_nmea
 
     ingest = ingest_params(query)
     conversion = _table_conversion(source.name, None)
+    if not needs_time:
+        conversion = _Conversion(conversion.convert, _timeless_identity, None)
     result = _FileResult(query, source.name, conversion, layout="nmea", sink=sink)
+    counts = NmeaCounts()
     with open_data(source, bar) as opened:
         text = io.TextIOWrapper(opened.stream, encoding="utf-8", errors="replace", newline="")
         try:
             batches = list(
-                read_nmea(_lines(text), source.name, result.ledger, ingest.nmea_time_sources)
+                read_nmea(
+                    _lines(text),
+                    source.name,
+                    result.ledger,
+                    ingest.nmea_time_sources,
+                    keep_timeless=not needs_time,
+                    counts=counts,
+                )
             )
         except (EOFError, OSError) as exc:
             raise decompression_error(source, exc) from None
         result.sha256 = opened.finish()
+    if needs_time and counts.timeless and not result.ledger.time_sources:
+        raise _no_time_error(source, counts.timeless, ingest.nmea_time_sources)
     for batch in batches:
         _nmea_batch(result, batch)
     result.settle()
     return result
+
+
+def _no_time_error(source: Source, messages: int, in_use: Sequence[str]) -> InputFileError:
+    looked = {
+        "tag_block": "tag blocks with c:",
+        "pghp": "$PGHP lines",
+        "arrival": "trailing unix times",
+    }
+    sources = ", ".join(looked.get(str(s), str(s)) for s in in_use)
+    return InputFileError(
+        f"{source.name}: no line has a time ({messages} AIS messages; looked for {sources}); "
+        "replay and ingest place positions in time and need one: give a log written with "
+        "receive times (tag blocks or trailing unix times), or use colregs9 stats, which "
+        "reads a log without times"
+    )
+
+
+def _timeless_identity(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
+    """NMEA rows kept without a time: a null timestamp is no time, not a bad one."""
+    return table, np.zeros(table.num_rows, dtype=bool)
 
 
 def _lines(text: io.TextIOWrapper) -> Iterator[str]:

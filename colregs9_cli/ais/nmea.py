@@ -20,7 +20,10 @@ sentence line (AIS or not) consumes the pending times, because ``$PGHP`` stamps 
 next sentence. A tag block whose checksum fails gives no time; so does a ``$PGHP`` line whose
 checksum or date fails. ``c:`` and trailing values above 1e11 are taken as milliseconds. A
 message with no time from the sources in use is rejected as unparseable: without a time it
-cannot be placed in a track.
+cannot be placed in a track. A reader that needs no time (``read_nmea``'s ``keep_timeless``:
+``colregs9 stats``, whose dimension statistics need none) keeps such messages with a null
+timestamp and counts them under the time source ``none``; ``NmeaCounts.timeless`` counts them
+either way, so that a caller can tell a log in which no line has a time.
 
 Multi-sentence messages are reassembled per (sentence tag, channel, sequential id, fragment
 count), so interleaved messages on other channels or ids do not disturb each other. A group
@@ -118,6 +121,16 @@ DEFAULT_TIME_SOURCES: tuple[TimeSource, ...] = (
 )
 # A message's time: milliseconds since the epoch, and its source.
 _Stamp = tuple[int, TimeSource]
+# The time of a message kept without one (``keep_timeless``): a null timestamp in the tables.
+NO_TIME_MS = int(np.iinfo(np.int64).min)
+NO_TIME_SOURCE = "none"
+
+
+@dataclass
+class NmeaCounts:
+    """What a read found besides the ledger: the AIS messages that had no time."""
+
+    timeless: int = 0
 
 
 @dataclass(frozen=True)
@@ -241,10 +254,17 @@ _STATIC_ONLY = (
 
 class _NmeaReader:
     def __init__(
-        self, source_name: str, ledger: RejectsLedger, time_sources: Sequence[TimeSource]
+        self,
+        source_name: str,
+        ledger: RejectsLedger,
+        time_sources: Sequence[TimeSource],
+        keep_timeless: bool = False,
+        counts: NmeaCounts | None = None,
     ) -> None:
         self.source_name = source_name
         self.ledger = ledger
+        self.keep_timeless = keep_timeless
+        self.counts = counts if counts is not None else NmeaCounts()
         self.time_sources = tuple(TimeSource(s) for s in time_sources)
         self.pending: dict[TimeSource, int] = {}
         self.open_groups: dict[tuple[str, str, int | None, int], _Fragments] = {}
@@ -352,17 +372,22 @@ class _NmeaReader:
         self.ledger.read()
         msg_type = sentence.ais_id
         if stamp is None:
-            used = ", ".join(s.value for s in self.time_sources)
-            self._reject_message(
-                RejectReason.UNPARSEABLE,
-                line_no,
-                f"no time from the time sources in use ({used}): no $PGHP line before it, "
-                "no tag block c:, no trailing unix time",
-                raw,
-            )
-            return
-        timestamp, source = stamp
-        self.ledger.time_sources[source.value] += 1
+            self.counts.timeless += 1
+            if not self.keep_timeless:
+                used = ", ".join(s.value for s in self.time_sources)
+                self._reject_message(
+                    RejectReason.UNPARSEABLE,
+                    line_no,
+                    f"no time from the time sources in use ({used}): no $PGHP line before it, "
+                    "no tag block c:, no trailing unix time",
+                    raw,
+                )
+                return
+            self.ledger.time_sources[NO_TIME_SOURCE] += 1
+            timestamp = NO_TIME_MS
+        else:
+            timestamp, source = stamp
+            self.ledger.time_sources[source.value] += 1
         if not sentence.payload:
             self._reject_message(RejectReason.UNPARSEABLE, line_no, "empty payload", raw)
             return
@@ -635,7 +660,14 @@ def _ship_type_text(codes: pd.Series) -> pa.Array:
 
 
 def _timestamps(milliseconds: pd.Series) -> pa.Array:
-    return pa.array(milliseconds.to_numpy(dtype=np.int64), type=pa.timestamp("ms", tz="UTC"))
+    """Milliseconds as timestamps; ``NO_TIME_MS`` (a message kept without a time) as null."""
+    values = milliseconds.to_numpy(dtype=np.int64)
+    missing = values == NO_TIME_MS
+    return pa.array(
+        values,
+        type=pa.timestamp("ms", tz="UTC"),
+        mask=missing if missing.any() else None,
+    )
 
 
 def _optional(values: pd.Series | np.ndarray, dtype: pa.DataType) -> pa.Array:
@@ -718,15 +750,19 @@ def read_nmea(
     source_name: str,
     ledger: RejectsLedger,
     time_sources: Sequence[TimeSource] = DEFAULT_TIME_SOURCES,
+    keep_timeless: bool = False,
+    counts: NmeaCounts | None = None,
 ) -> Iterator[AisBatch]:
     """Decode a raw NMEA AIS log into one batch of positions and static reports.
 
     ``lines`` are the log's text lines; ``source_name`` names the file in reject examples
     ("file:line: why: sentence"). Every AIS message is counted with ``ledger.read()`` and
     becomes one output row or one reject (see the module docstring for the rules).
-    ``time_sources``: which times to use, in order of precedence.
+    ``time_sources``: which times to use, in order of precedence. ``keep_timeless``: keep
+    the messages without a time (null timestamp) instead of rejecting them; ``counts``
+    receives how many there were either way.
     """
-    reader = _NmeaReader(source_name, ledger, time_sources)
+    reader = _NmeaReader(source_name, ledger, time_sources, keep_timeless, counts)
     ledger.time_source_order = tuple(s.value for s in reader.time_sources)
     for line_no, line in enumerate(lines, start=1):
         reader.feed(line_no, line)
