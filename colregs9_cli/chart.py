@@ -591,6 +591,8 @@ def _assemble(
 
 def _read_features(path: Path) -> _Features:
     path = Path(path)
+    if path.is_dir():
+        raise ChartError(f"{path}: a directory, not a chart file; give the chart file itself")
     if not path.is_file():
         raise ChartError(f"{path}: no such chart file; check the path")
     suffix = path.suffix.lower()

@@ -3,9 +3,11 @@ available": never in the statistics, never an error in the replay."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
 import pytest
 
 from colregs9_cli.ais.load import load_ais
@@ -68,3 +70,156 @@ def test_an_mmsi_too_long_for_any_vessel_is_invalid_without_a_warning(
         data = load_ais([path])
     assert data.ledger.balanced
     assert data.ledger.to_dict()["rejects_by_reason"].get("invalid_mmsi", 0) >= 1
+
+
+# -- implausible dimensions: found on each reader's path, counted apart in the ledger ----------
+
+# (length, breadth, draught) as read -> whether cleaning drops one as implausible
+_DIMENSION_CASES = [
+    (("288", "49", "10.5"), False),  # a real ship
+    (("600", "49", "10.5"), True),  # longer than any ship
+    (("288", "81", "10.5"), True),  # wider
+    (("288", "49", "31"), True),  # deeper
+    (("inf", "49", "10.5"), True),
+    (("1e400", "49", "10.5"), True),
+    (("0", "0", "0"), False),  # not available, not implausible
+    (("-inf", "nan", ""), False),
+    (("500", "80", "30"), False),  # the limits themselves are plausible
+]
+
+
+def _implausible_dma(length: str, breadth: str, draught: str) -> bool:
+    from colregs9_cli.ais.dma import dma_fields
+
+    batch = pa.table(
+        {
+            "mmsi": ["219000000"],
+            "latitude": ["57.0"],
+            "longitude": ["10.0"],
+            "type of mobile": ["Class A"],
+            "width": [breadth],
+            "length": [length],
+            "draught": [draught],
+        }
+    )
+    return bool(dma_fields(batch, has_abcd=False).dimensions.implausible()[0])
+
+
+def _implausible_dma_abcd(length: str, breadth: str, draught: str) -> bool:
+    """Length as A+B, breadth as C+D (the DMA's own way when they are given)."""
+    from colregs9_cli.ais.dma import dma_fields
+
+    half = {v: str(float(v) / 2) if v not in ("", "nan") else v for v in (length, breadth)}
+    batch = pa.table(
+        {
+            "mmsi": ["219000000"],
+            "latitude": ["57.0"],
+            "longitude": ["10.0"],
+            "type of mobile": ["Class A"],
+            "width": [""],
+            "length": [""],
+            "draught": [draught],
+            "a": [half[length]],
+            "b": [half[length]],
+            "c": [half[breadth]],
+            "d": [half[breadth]],
+        }
+    )
+    return bool(dma_fields(batch, has_abcd=True).dimensions.implausible()[0])
+
+
+def _implausible_marinecadastre(length: str, breadth: str, draught: str) -> bool:
+    from colregs9_cli.ais.column_map import BUILTIN_MAPS
+    from colregs9_cli.ais.mapped import mapped_fields
+
+    map_ = BUILTIN_MAPS["marinecadastre"]
+    values = {name: [None] for name in map_.read_columns}
+    values.update(
+        mmsi=["219000000"],
+        lat=["57.0"],
+        lon=["10.0"],
+        transceiverclass=["A"],
+        length=[length],
+        width=[breadth],
+        draft=[draught],
+    )
+    batch = pa.table({k: pa.array(v, pa.string()) for k, v in values.items()})
+    return bool(mapped_fields(map_, batch).dimensions.implausible()[0])
+
+
+def _implausible_canonical(length: str, breadth: str, draught: str) -> bool:
+    """Parquet datasets and decoded NMEA: canonical float columns."""
+    from colregs9_cli.ais.clean import DimensionColumns
+    from colregs9_cli.ais.load import _canonical_dimensions
+
+    def number(text: str) -> float | None:
+        return None if text == "" else float(text)
+
+    table = pa.table(
+        {
+            "length_m": pa.array([number(length)], pa.float64()),
+            "breadth_m": pa.array([number(breadth)], pa.float64()),
+            "draught_m": pa.array([number(draught)], pa.float64()),
+        }
+    )
+    return bool(DimensionColumns(table, _canonical_dimensions).implausible()[0])
+
+
+@pytest.mark.parametrize(
+    "reader",
+    [_implausible_dma, _implausible_dma_abcd, _implausible_marinecadastre, _implausible_canonical],
+)
+@pytest.mark.parametrize(("values", "expected"), _DIMENSION_CASES)
+def test_each_reader_finds_the_dimensions_it_drops_as_implausible(
+    reader, values: tuple[str, str, str], expected: bool
+) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert reader(*values) is expected
+
+
+def test_finding_them_leaves_the_limits_in_force() -> None:
+    from colregs9_cli.ais.clean import DimensionColumns, plausible
+
+    table = pa.table({"length_m": [600.0], "breadth_m": [10.0], "draught_m": [5.0]})
+    columns = DimensionColumns(
+        table, lambda t: plausible(tuple(t.column(c).to_numpy() for c in t.column_names))
+    )
+    assert columns.implausible().tolist() == [True]
+    length, breadth, _ = columns.of_rows(np.array([0]))
+    assert np.isnan(length[0]) and breadth[0] == 10.0  # still dropped when cleaned
+
+
+def test_the_ledger_counts_dropped_values_apart_from_the_balance() -> None:
+    from colregs9_cli.ais.ledger import DropReason, RejectReason, RejectsLedger
+
+    ledger = RejectsLedger()
+    ledger.read(10)
+    ledger.use(9)
+    ledger.reject(RejectReason.UNPARSEABLE)
+    ledger.drop(DropReason.IMPLAUSIBLE_DIMENSION, 4, example="x.csv:3: length 600")
+    part = RejectsLedger(rows_read=2, rows_used=2)
+    part.drop(DropReason.IMPLAUSIBLE_DIMENSION, 2, example="y.csv:9: draught inf")
+    ledger.merge(part)
+    assert ledger.balanced
+    payload = ledger.to_dict()
+    assert payload["values_dropped"] == {"implausible_dimension": 6}
+    assert payload["values_dropped_examples"]["implausible_dimension"] == [
+        "x.csv:3: length 600",
+        "y.csv:9: draught inf",
+    ]
+    assert payload["rows_rejected"] == 1
+    assert RejectsLedger.from_dict(payload).to_dict() == payload
+    assert "values_dropped" not in RejectsLedger().to_dict()  # unchanged without any
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="ais/load.py must count DimensionColumns.implausible() in its ledger (RejectsLedger"
+    ".drop); it is another developer's file",
+)
+def test_load_counts_implausible_dimensions_in_the_ledger(tmp_path: Path) -> None:
+    path = _with_length(tmp_path, "900")
+    ledger = load_ais([path]).ledger
+    assert ledger.balanced
+    assert ledger.dropped["implausible_dimension"] == ledger.rows_read

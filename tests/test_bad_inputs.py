@@ -17,6 +17,7 @@ import gzip
 import io
 import json
 import lzma
+import os
 import shutil
 import struct
 import subprocess
@@ -30,6 +31,8 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
+
+from colregs9_cli.ais.schema import CANONICAL_SCHEMA
 
 from fixture_files import DEMO_DATA, DMA26, MARINECADASTRE, MODELLED_CHART, NMEA, ROOT
 
@@ -269,6 +272,28 @@ def _queries(work: Path) -> dict[str, tuple[str, str]]:
         "alpha_range": ("[manoeuvrability]\nalpha = 5", "alpha"),
         "alpha_text": ('[manoeuvrability]\nalpha = "z"', "alpha"),
         "ingest_time_sources": ('[ingest]\nnmea_time_sources = ["sundial"]', "nmea_time_sources"),
+        "ingest_time_sources_nested": (
+            '[ingest]\nnmea_time_sources = [["pghp"]]',
+            "[ingest]: key 'nmea_time_sources'",
+        ),
+        "ingest_time_sources_table": ("[ingest]\nnmea_time_sources = {x = 1}", "nmea_time_sources"),
+        "manoeuvrability_swing_model_list": (
+            "[manoeuvrability]\nswing_model = []",
+            "[manoeuvrability]: key 'swing_model'",
+        ),
+        "manoeuvrability_policy_nested": ("[manoeuvrability]\npolicy = [[1]]", "'policy'"),
+        "manoeuvrability_step_memory": ("[manoeuvrability]\nstep_s = 1e-6", "step_s"),
+        "manoeuvrability_horizon_huge": ("[manoeuvrability]\nhorizon_s = 1e12", "horizon_s"),
+        "colregs_course_source_table": ("[colregs]\ncourse_source = {x = 1}", "course_source"),
+        "replay_slab_tiny": ("[replay]\nslab_s = 1e-300", "slab_s"),
+        "replay_slab_huge": ("[replay]\nslab_s = 1e300", "slab_s"),
+        "replay_range_tiny": ("[replay]\ncandidate_range_m = 1e-300", "candidate_range_m"),
+        "replay_range_below_cpa": ("[replay]\ncandidate_range_m = 100", "candidate_range_m"),
+        "polygon_empty": (
+            '[region]\npolygon = \'{"type":"Polygon","coordinates":[]}\'',
+            "[region] polygon",
+        ),
+        "polygon_file_directory": ("[region]\npolygon_file = '.'", "a directory, not a file"),
     }
     return {
         name: (_write(work, f"queries/{name}.toml", text + "\n"), expected)
@@ -299,6 +324,24 @@ def _scenarios(work: Path) -> dict[str, tuple[str, str]]:
             "no_chart.geojson",
         ),
         "unknown_key": (base + "\ncolour = 1\n", "colour"),
+        "start_year_9999": (
+            base.replace("start_utc = 2024-09-09T12:00:00Z", "start_utc = 9999-12-31T23:59:00Z"),
+            "start_utc",
+        ),
+        "start_overflows": (
+            base.replace(
+                "start_utc = 2024-09-09T12:00:00Z", "start_utc = 9999-12-31T23:59:00-05:00"
+            ),
+            "start_utc",
+        ),
+        "start_1970": (
+            base.replace("start_utc = 2024-09-09T12:00:00Z", "start_utc = 1970-01-01T00:00:00Z"),
+            "start_utc",
+        ),
+        "chart_directory": (base.replace(json.dumps(chart), '"."'), "not a file"),
+        "length_600": (base.replace("length_m = 50.0", "length_m = 600.0"), "length_m"),
+        "draught_inf": (base.replace("draught_m = 0.5", "draught_m = inf"), "draught_m"),
+        "speed_huge": (base.replace("speed_kn = 7.0", "speed_kn = 1e9"), "speed_kn"),
     }
     return {
         name: (_write(work, f"scenarios/{name}.toml", text), expected)
@@ -323,7 +366,13 @@ def _charts(work: Path) -> dict[str, str]:
     no_drval = json.loads(MODELLED_CHART.read_text())
     for feature in no_drval["features"]:
         feature["properties"].pop("DRVAL1", None)
+    nan_vertex = json.dumps(off_earth).replace(
+        "[[500, 100], [501, 100], [501, 101], [500, 100]]",
+        "[[10, 57], [NaN, 57], [10.1, 57.1], [10, 57]]",
+    )
     return {
+        "nan_vertex": _write(work, "charts/nan_vertex.geojson", nan_vertex),
+        "zeroed_gpkg": _write(work, "charts/zeroed.gpkg", b"SQLite format 3\x00" + bytes(100)),
         "not_a_chart": _write(work, "charts/not_a_chart.geojson", "{nope"),
         "chart_text": _write(work, "charts/chart.000", "not an S-57 cell"),
         "off_earth": _write(work, "charts/off_earth.geojson", json.dumps(off_earth)),
@@ -331,9 +380,137 @@ def _charts(work: Path) -> dict[str, str]:
     }
 
 
+def _datasets(work: Path) -> dict[str, str]:
+    """Datasets made by ``ingest`` (in-process), then spoilt: a foreign Parquet file beside
+    the partitions, and a partition rewritten with another schema."""
+    from colregs9_cli.ais.dataset import ingest
+
+    made = work / "datasets" / "good"
+    foreign = work / "datasets" / "foreign"
+    wrong = work / "datasets" / "wrong_schema"
+    if not made.exists():  # the cases are listed twice (test_there_are_at_least_150_kinds)
+        ingest([DMA26], made)
+        shutil.copytree(made, foreign)
+        pq.write_table(pa.table({"x": [1]}), foreign / "foreign.parquet")
+        shutil.copytree(made, wrong)
+        pq.write_table(pa.table({"mmsi": ["x"]}), next(wrong.rglob("*.parquet")))
+    partition = next(wrong.rglob("*.parquet"))
+    return {
+        "good": "datasets/good",
+        "foreign": "datasets/foreign",
+        "wrong_schema": str(partition.relative_to(work)),
+        "wrong_schema_dir": "datasets/wrong_schema",
+    }
+
+
+# Inputs with no usable AIS row (none at all, or every one rejected): ingest should refuse
+# them as stats and replay do (exit 2, naming the file), but colregs9_cli/ais/dataset.py (not
+# in this change) writes "0 rows written" and exits 0.
+INGEST_ZERO_ROWS = (
+    "ingest-ais-nmea_gps_only",
+    "ingest-ais-nmea_bad_checksums",
+    "ingest-ais-all_rows_bad_mmsi",
+    "ingest-zero-rows-parquet",
+)
+
+
+def _ingest_cases(
+    work: Path, ais: dict[str, str], datasets: dict[str, str], a_file: str, good: str
+) -> list[Case]:
+    cases = []
+    common = (
+        "missing",
+        "directory",
+        "empty",
+        "header_only",
+        "binary",
+        "unknown_layout",
+        "headerless_dma",
+        "truncated_gzip",
+        "zip_two_csvs",
+        "zip_encrypted",
+        "tar_gz",
+        "not_utf8",
+        "parquet_missing_column",
+        "parquet_duplicate_column",
+        "nmea_gps_only",
+        "nmea_bad_checksums",
+        "all_rows_bad_mmsi",
+    )
+    for name in common:
+        cases.append(
+            Case(
+                f"ingest-ais-{name}",
+                ("ingest", ais[name], "--out", f"out/ingest-{name}", "--quiet"),
+                2,
+                ais[name],
+            )
+        )
+    zero = _write(work, "zero_rows.parquet", _parquet(CANONICAL_SCHEMA.empty_table()))
+    cases += [
+        Case(
+            "ingest-zero-rows-parquet",
+            ("ingest", zero, "--out", "out/ingest-zero", "--quiet"),
+            2,
+            zero,
+        ),
+        Case("ingest-out-is-a-file", ("ingest", good, "--out", a_file, "--quiet"), 2, a_file),
+        Case(
+            "ingest-out-under-a-file",
+            ("ingest", good, "--out", f"{a_file}/ds", "--quiet"),
+            2,
+            a_file,
+        ),
+        Case(
+            "ingest-out-not-a-dataset",
+            ("ingest", good, "--out", "foreign", "--quiet"),
+            2,
+            "not a colregs9 dataset",
+        ),
+        Case(
+            "ingest-a-dataset-as-input",
+            ("ingest", datasets["good"], "--out", "out/ingest-ds", "--quiet"),
+            2,
+            datasets["good"],
+        ),
+        Case(
+            "ingest-query-bad",
+            ("ingest", good, "--query", "queries/syntax.toml", "--out", "out/i-q", "--quiet"),
+            2,
+            "TOML syntax error",
+        ),
+        Case(
+            "ingest-query-time-sources-nested",
+            (
+                "ingest",
+                good,
+                "--query",
+                "queries/ingest_time_sources_nested.toml",
+                "--out",
+                "out/i-q2",
+                "--quiet",
+            ),
+            2,
+            "nmea_time_sources",
+        ),
+        Case(
+            "ingest-format-bad",
+            ("ingest", good, "--format", "csv", "--out", "out/i-f", "--quiet"),
+            2,
+            "--format",
+        ),
+    ]
+    return cases
+
+
 def _cases(work: Path) -> list[Case]:
     ais = _ais_files(work)
     accepted = _accepted_ais(work)
+    datasets = _datasets(work)
+    for fifo in ("a_fifo", "a_fifo.png"):  # never a device node: refused unopened
+        if not (work / fifo).exists():
+            os.mkfifo(work / fifo)
+    (work / "plot_dir.png").mkdir(exist_ok=True)
     queries = _queries(work)
     scenarios = _scenarios(work)
     charts = _charts(work)
@@ -367,7 +544,8 @@ def _cases(work: Path) -> list[Case]:
                 )
             )
         for name, (path, expected) in queries.items():
-            if command == "stats" and name.split("_")[0] in ("replay", "colregs", "alpha"):
+            stages = ("replay", "colregs", "alpha", "manoeuvrability")
+            if command == "stats" and name.split("_")[0] in stages:
                 continue  # stats does not read the replay's tables
             cases.append(
                 Case(f"{command}-query-{name}", (command, good, "--query", path, *out), 2, expected)
@@ -396,10 +574,109 @@ def _cases(work: Path) -> list[Case]:
                 "basedatetime",
             ),
             Case(f"{command}-no-input", (command, "--quiet"), 2, ""),
+            Case(
+                f"{command}-query-a-directory",
+                (command, good, "--query", "queries", *out),
+                2,
+                "queries: a directory, not a file",
+            ),
+            Case(
+                f"{command}-dataset-foreign-parquet",
+                (command, datasets["foreign"], *out),
+                2,
+                "foreign.parquet",
+            ),
+            Case(
+                f"{command}-dataset-wrong-schema",
+                (command, datasets["wrong_schema"], *out),
+                2,
+                datasets["wrong_schema"],
+            ),
             Case(f"{command}-unknown-option", (command, good, "--bogus"), 2, "--bogus"),
         ]
     nmea = str(NMEA)
     replay_out = ("--out", "out/replay", "--quiet", "--no-plots")
+    fifo = str(work / "a_fifo")
+    cases += _ingest_cases(work, ais, datasets, a_file, good)
+    cases += [
+        Case(
+            "replay-slab-tiny",
+            ("replay", nmea, "--slab-minutes", "1e-9", *replay_out),
+            2,
+            "--slab-minutes",
+        ),
+        Case(
+            "replay-slab-underflow",
+            ("replay", nmea, "--slab-minutes", "1e-300", *replay_out),
+            2,
+            "slab_s",
+        ),
+        Case(
+            "replay-slab-huge",
+            ("replay", nmea, "--slab-minutes", "1e300", *replay_out),
+            2,
+            "slab_s",
+        ),
+        Case(
+            "replay-range-tiny",
+            ("replay", nmea, "--candidate-range-m", "1e-300", *replay_out),
+            2,
+            "candidate_range_m",
+        ),
+        Case(
+            "replay-chart-nan-vertex",
+            ("replay", nmea, "--chart", charts["nan_vertex"], *replay_out),
+            2,
+            f"{charts['nan_vertex']}: layer nan_vertex, feature 1 (DEPARE)",
+        ),
+        Case(
+            "replay-chart-a-directory",
+            ("replay", nmea, "--chart", "charts", *replay_out),
+            2,
+            "charts",
+        ),
+        Case(
+            "chart-nan-vertex",
+            ("chart", charts["nan_vertex"]),
+            2,
+            f"{charts['nan_vertex']}: layer nan_vertex, feature 1 (DEPARE)",
+        ),
+        Case("chart-zeroed-gpkg", ("chart", charts["zeroed_gpkg"]), 2, charts["zeroed_gpkg"]),
+        Case(
+            "chart-draught-huge",
+            ("chart", str(MODELLED_CHART), "--draught", "1e308"),
+            2,
+            "--draught",
+        ),
+        Case(
+            "chart-draught-nan", ("chart", str(MODELLED_CHART), "--draught", "nan"), 2, "--draught"
+        ),
+        Case(
+            "chart-ukc-huge",
+            ("chart", str(MODELLED_CHART), "--draught", "2", "--ukc", "1e308"),
+            2,
+            "--ukc",
+        ),
+        Case(
+            "chart-out-a-fifo",
+            ("chart", str(MODELLED_CHART), "--draught", "2", "--out", f"{fifo}.png"),
+            2,
+            "named pipe",
+        ),
+        Case(
+            "chart-out-a-directory",
+            ("chart", str(MODELLED_CHART), "--draught", "2", "--out", "plot_dir.png"),
+            2,
+            "plot_dir.png: --out is a directory",
+        ),
+        Case(
+            "simulate-out-a-fifo",
+            ("simulate", str(DEMO_DATA / "greenhopper_restricted.toml"), "--out", fifo),
+            2,
+            "named pipe",
+        ),
+        Case("simulate-a-directory", ("simulate", "charts", "--quiet"), 2, "a directory"),
+    ]
     cases += [
         Case(
             "stats-per-bad",
@@ -630,7 +907,20 @@ def _check(case: Case, code: object, stdout: str, stderr: str, escaped: object, 
     assert case.names in errors[0], errors[0]
 
 
-@pytest.mark.parametrize("case_id", CASE_IDS)
+@pytest.mark.parametrize(
+    "case_id",
+    [
+        pytest.param(
+            case_id,
+            marks=pytest.mark.xfail(
+                strict=True, reason="ingest of zero AIS rows: a fix in ais/dataset.py"
+            ),
+        )
+        if case_id in INGEST_ZERO_ROWS
+        else case_id
+        for case_id in CASE_IDS
+    ],
+)
 def test_bad_input(case_id: str, cases, results, work: Path) -> None:
     case = cases[case_id]
     result = results[case_id]

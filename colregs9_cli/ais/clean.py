@@ -2,13 +2,16 @@
 
 "Not available" becomes null (DESIGN §4): latitude outside ±90 (91), longitude outside ±180
 (181), SOG 102.3 and above, COG 360 and above, heading 360 and above (511), a rate of turn
-beyond ±720 deg/min (the sentinel -128 decoded), dimension 0 or less, draught 0 or less, IMO
-0 or less, and the texts ``Unknown``, ``Undefined``, ``Unknown value`` and empty text in
-text columns.
+beyond ±720 deg/min (the sentinel -128 decoded), dimension 0 or less, draught 0 or less, a
+dimension beyond what ships have or not finite (``MAX_LENGTH_M`` ...; counted as
+``implausible_dimension``), IMO 0 or less, and the texts ``Unknown``, ``Undefined``,
+``Unknown value`` and empty text in text columns.
 """
 
 from __future__ import annotations
 
+import contextvars
+import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -230,20 +233,40 @@ Dimensions = tuple[FloatArray, FloatArray, FloatArray]
 
 # The largest dimensions a ship has (metres): the longest ships are under 460 m, the widest
 # under 70 m, and AIS encodes a draught of at most 25.5 m. Beyond these, or not finite, a
-# value is a corrupt field (``inf``, ``1e400``) and is treated as not available.
+# value is a corrupt field (``inf``, ``1e400``): it is dropped (NaN, as not available), never
+# used in a statistic, and counted in the ledger as ``implausible_dimension``
+# (``DimensionColumns.implausible``).
 MAX_LENGTH_M = 500.0
 MAX_BREADTH_M = 80.0
 MAX_DRAUGHT_M = 30.0
+_LIMITS_M = (MAX_LENGTH_M, MAX_BREADTH_M, MAX_DRAUGHT_M)
+# The limits ``plausible`` applies: lifted (to infinity, which still drops NaN) only while
+# ``DimensionColumns.implausible`` looks for what they drop.
+_limits_m: contextvars.ContextVar[tuple[float, float, float]] = contextvars.ContextVar(
+    "dimension_limits_m", default=_LIMITS_M
+)
 
 
 def plausible(dimensions: Dimensions) -> Dimensions:
     """Length, breadth and draught with implausible values (module limits) as NaN."""
     length_m, breadth_m, draught_m = dimensions
+    max_length_m, max_breadth_m, max_draught_m = _limits_m.get()
     return (
-        null_outside(length_m, 0.0, MAX_LENGTH_M),
-        null_outside(breadth_m, 0.0, MAX_BREADTH_M),
-        null_outside(draught_m, 0.0, MAX_DRAUGHT_M),
+        null_outside(length_m, 0.0, max_length_m),
+        null_outside(breadth_m, 0.0, max_breadth_m),
+        null_outside(draught_m, 0.0, max_draught_m),
     )
+
+
+def implausible(dimensions: Dimensions) -> BoolArray:
+    """Rows with a dimension that is reported (positive) but beyond the module limits or not
+    finite: ``plausible`` would drop it."""
+    with np.errstate(invalid="ignore"):
+        beyond = [
+            (values > 0.0) & ~(values <= limit_m)
+            for values, limit_m in zip(dimensions, _LIMITS_M, strict=True)
+        ]
+    return np.asarray(beyond[0] | beyond[1] | beyond[2], dtype=bool)
 
 
 @dataclass(frozen=True)
@@ -260,6 +283,23 @@ class DimensionColumns:
 
     def of_rows(self, rows: NDArray[np.int64]) -> Dimensions:
         return self.clean(self.table.take(pa.array(rows, pa.int64())))
+
+    def implausible(self, table: pa.Table | None = None) -> BoolArray:
+        """Which rows of ``table`` (columns as ``self.table``'s, more may follow; default
+        ``self.table``) report a dimension that cleaning drops as implausible: beyond the
+        module limits or not finite. The reader's own cleaning is run again with the limits
+        lifted, so that every layout's way of making a dimension (A+B, or Length) counts."""
+        rows = self.table if table is None else table
+        token = _limits_m.set((math.inf, math.inf, math.inf))
+        try:
+            unbounded = self.clean(rows)
+        finally:
+            _limits_m.reset(token)
+        return implausible(unbounded)
+
+    def implausible_rows(self, rows: NDArray[np.int64]) -> BoolArray:
+        """``implausible`` for some rows of ``self.table`` (indices)."""
+        return self.implausible(self.table.take(pa.array(rows, pa.int64())))
 
 
 def any_dimension(length_m: FloatArray, breadth_m: FloatArray, draught_m: FloatArray) -> BoolArray:

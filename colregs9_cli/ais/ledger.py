@@ -20,6 +20,12 @@ class RejectReason(StrEnum):
     UNSUPPORTED_MESSAGE = "unsupported_message_type"
 
 
+class DropReason(StrEnum):
+    """Why a value was dropped from a row that was kept (the row itself counts as used)."""
+
+    IMPLAUSIBLE_DIMENSION = "implausible_dimension"
+
+
 @dataclass
 class RejectsLedger:
     """Counts of rows read, used, left out by the query, and rejected (by reason).
@@ -27,6 +33,11 @@ class RejectsLedger:
     ``rows_read == rows_used + rows_outside_query + rejected_total`` holds after every
     complete read. Rows outside the query are valid input that the query does not select;
     they are not rejects, but they are counted so that nothing disappears unaccounted.
+
+    ``dropped`` counts rows read that kept their place but lost a value, by reason: a
+    dimension beyond what ships have (``ais.clean.MAX_LENGTH_M`` ...) or not finite is
+    dropped as ``implausible_dimension``: the row's position is good, its dimension goes into
+    no statistic. These are not in the balance (the row is used, outside or rejected).
     """
 
     rows_read: int = 0
@@ -39,6 +50,8 @@ class RejectsLedger:
     # Examples of rejected rows, for the manifest: reason -> a few "file:line: value" strings.
     examples: dict[str, list[str]] = field(default_factory=dict)
     max_examples: int = 5
+    dropped: Counter[str] = field(default_factory=Counter)
+    dropped_examples: dict[str, list[str]] = field(default_factory=dict)
 
     def read(self, n: int = 1) -> None:
         self.rows_read += n
@@ -58,9 +71,20 @@ class RejectsLedger:
             if len(bucket) < self.max_examples:
                 bucket.append(example)
 
-    def wants_example(self, reason: RejectReason) -> bool:
+    def wants_example(self, reason: RejectReason | DropReason) -> bool:
         """Whether an example of ``reason`` would still be kept (to skip building it)."""
-        return len(self.examples.get(reason.value, ())) < self.max_examples
+        kept = self.dropped_examples if isinstance(reason, DropReason) else self.examples
+        return len(kept.get(reason.value, ())) < self.max_examples
+
+    def drop(self, reason: DropReason, n: int = 1, example: str | None = None) -> None:
+        """Count ``n`` rows that lost a value for ``reason`` (the rows are counted apart)."""
+        if n <= 0:
+            return
+        self.dropped[reason.value] += n
+        if example is not None:
+            bucket = self.dropped_examples.setdefault(reason.value, [])
+            if len(bucket) < self.max_examples:
+                bucket.append(example)
 
     def merge(self, part: RejectsLedger) -> None:
         """Add the counts, time sources and (up to ``max_examples``) examples of ``part``."""
@@ -71,9 +95,14 @@ class RejectsLedger:
             self.rejects[reason] += count
         self.time_sources.update(part.time_sources)
         self.time_source_order = self.time_source_order or part.time_source_order
-        for reason, examples in part.examples.items():
-            bucket = self.examples.setdefault(reason, [])
-            bucket.extend(examples[: max(0, self.max_examples - len(bucket))])
+        self.dropped.update(part.dropped)
+        for mine, theirs in (
+            (self.examples, part.examples),
+            (self.dropped_examples, part.dropped_examples),
+        ):
+            for reason, examples in theirs.items():
+                bucket = mine.setdefault(reason, [])
+                bucket.extend(examples[: max(0, self.max_examples - len(bucket))])
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> RejectsLedger:
@@ -87,6 +116,11 @@ class RejectsLedger:
             time_sources=Counter({str(k): int(v) for k, v in data.get("time_sources", {}).items()}),
             time_source_order=tuple(str(s) for s in data.get("time_source_order", ())),
             examples={str(k): [str(e) for e in v] for k, v in data["reject_examples"].items()},
+            dropped=Counter({str(k): int(v) for k, v in data.get("values_dropped", {}).items()}),
+            dropped_examples={
+                str(k): [str(e) for e in v]
+                for k, v in data.get("values_dropped_examples", {}).items()
+            },
         )
         if ledger.rejected_total != int(data["rows_rejected"]) or not ledger.balanced:
             raise ValueError("the ledger's counts do not add up")
@@ -114,6 +148,14 @@ class RejectsLedger:
                     "time_source_order": list(self.time_source_order),
                 }
                 if self.time_sources
+                else {}
+            ),
+            **(
+                {
+                    "values_dropped": dict(sorted(self.dropped.items())),
+                    "values_dropped_examples": dict(sorted(self.dropped_examples.items())),
+                }
+                if self.dropped
                 else {}
             ),
         }
