@@ -878,7 +878,9 @@ def _in_query(table: pa.Table, query: Query) -> np.ndarray:
         # the schema's unit: milliseconds since the epoch; a row without a time (NaN: an
         # NMEA message read by stats) is outside any window
         stamps = table.column("timestamp").cast(pa.int64())
-        milliseconds = to_numpy_float(stamps) if stamps.null_count else stamps.to_numpy()
+        milliseconds = (
+            to_numpy_float(stamps.cast(pa.float64())) if stamps.null_count else stamps.to_numpy()
+        )
         if window.start is not None:
             keep &= milliseconds >= round(window.start.timestamp() * 1000)
         if window.end is not None:
