@@ -12,8 +12,9 @@ spilled reports): give ``--scratch`` on a file system they all mount.
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import ExitStack, closing, contextmanager
 from pathlib import Path
 
 import dask
@@ -48,18 +49,41 @@ def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
     # Dask's nannies set MALLOC_TRIM_THRESHOLD_=65536 in their workers, so that freed memory
     # goes back to the system at once; on a slab's arrays that makes every task 1.7x slower.
     # A slab's memory is bounded anyway: keep glibc's own threshold.
-    with (
-        dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}),
-        LocalCluster(
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+        cluster = LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
             silence_logs=logging.ERROR,
-        ) as cluster,
-        Client(cluster) as client,
-    ):
+        )
+    # Not made the default client: that is a context variable of the thread that starts it
+    # (``dask_client_soon``), and the run's own thread uses and closes it.
+    with closing(cluster), closing(Client(cluster, set_as_default=False)) as client:
+        # The workers import the replay (pandas, shapely, matplotlib: a second or two each)
+        # now, while this process reads the input, not when the first slab arrives.
+        client.run(_ready, wait=False)
         yield client
+
+
+async def _ready() -> None:
+    """Nothing: unpickling it on a worker imports this module and so the whole replay (a
+    coroutine, as Dask runs only those without waiting)."""
+
+
+@contextmanager
+def dask_client_soon(workers: int, scheduler: str | None) -> Iterator[Callable[[], Client]]:
+    """``dask_client``, started while the caller goes on: yields a function that waits for
+    the client. A scheduler given by address is reached at once, so that an unreachable one
+    stops the run before any work; a local cluster starts on a thread (importing Dask and
+    spawning the workers take a few seconds, mostly waiting)."""
+    if scheduler is not None:
+        with dask_client(workers, scheduler) as client:
+            yield lambda: client
+        return
+    with ExitStack() as stack, ThreadPoolExecutor(max_workers=1) as pool:
+        # Leaving waits for the start, then closes the cluster, even after an error.
+        yield pool.submit(stack.enter_context, dask_client(workers, None)).result
 
 
 def dask_slabs(
@@ -81,7 +105,7 @@ def dask_slabs(
         pure=False,
     )
     results: list[SlabResult] = []
-    for future in as_completed(futures):
+    for future in as_completed(futures, loop=client.loop):
         results.append(future.result())
         bar.advance()
         bar.describe("done: " + slab_label(results[-1].slab, context.params.slab_s))
@@ -109,7 +133,7 @@ def dask_drawer(client: Client) -> Drawer:
             frame=frame,
             pure=False,
         )
-        for future in as_completed(futures):
+        for future in as_completed(futures, loop=client.loop):
             future.result()
             progress.advance()
 

@@ -894,11 +894,12 @@ def run_replay(
     with ExitStack() as stack:
         cluster = None
         if workers > 1 or scheduler is not None:
-            # Before the work, so that an unreachable scheduler stops the run at once; only
-            # here, as importing Dask takes a second.
-            from .dask_run import dask_client
+            # Before the work, so that an unreachable scheduler stops the run at once (a
+            # local cluster starts beside the reading); only here, as importing Dask takes a
+            # second.
+            from .dask_run import dask_client_soon
 
-            cluster = stack.enter_context(dask_client(workers, scheduler))
+            cluster = stack.enter_context(dask_client_soon(workers, scheduler))
         query = load_query(query_path) if query_path is not None else everything_query()
         params = run_params(query, own_mmsi, overrides)
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
@@ -937,7 +938,7 @@ def run_replay(
                 else:
                     from .dask_run import dask_slabs
 
-                    results = dask_slabs(cluster, slabs, context, evaluate, chart, bar)
+                    results = dask_slabs(cluster(), slabs, context, evaluate, chart, bar)
         outcomes = [pair for result in results for pair in result.pairs]
         ledger = _ledger_with_tracks(ais.ledger, segmentation.stats)
         track_stats = dataclasses.replace(
@@ -981,7 +982,7 @@ def run_replay(
                 else:
                     from .dask_run import dask_drawer
 
-                    drawer = dask_drawer(cluster)
+                    drawer = dask_drawer(cluster())
                     files = write_replay_reports(result, chart, plots, bar, drawer)
         return dataclasses.replace(result, files=files, text=format_summary(result))
 
