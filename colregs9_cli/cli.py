@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -12,7 +13,7 @@ import typer
 from typer.core import TyperCommand
 
 from . import __version__
-from .errors import Colregs9Error
+from .errors import Colregs9Error, OutputError
 from .quick_exit import run_and_exit
 
 # --quiet means the same everywhere: stdout carries the results, stderr the progress and the
@@ -104,6 +105,19 @@ def _user_errors() -> Iterator[None]:
         message = str(exc).replace("\r", "\\r").replace("\n", "\\n")
         typer.echo(f"Error: {message}", err=True)
         raise typer.Exit(exc.exit_code) from None
+
+
+def _out_file(raw: str | None) -> Path | None:
+    """An ``--out`` that names a file, as typed: a trailing separator names a directory,
+    which ``Path`` would drop (``trail.png/`` would write ``trail.png``)."""
+    if raw is None:
+        return None
+    if raw.endswith(tuple(sep for sep in (os.sep, os.altsep) if sep)):
+        raise OutputError(
+            f"{raw}: --out ends in a path separator, so it names a directory; "
+            "give the path of a file to write"
+        )
+    return Path(raw)
 
 
 def _version(value: bool) -> None:
@@ -315,7 +329,7 @@ def simulate_command(
         ),
     ],
     out: Annotated[
-        Path | None,
+        str | None,  # as typed: see _out_file
         typer.Option(
             "--out",
             metavar="FILE.csv",
@@ -336,7 +350,7 @@ def simulate_command(
     from .simulate import simulate_scenario
 
     with _user_errors():
-        result = simulate_scenario(scenario, out, quiet=quiet)
+        result = simulate_scenario(scenario, _out_file(out), quiet=quiet)
     typer.echo(result.text, nl=False)
     if not quiet:
         typer.echo(f"AIS written to {result.out_path}", err=True)
@@ -536,7 +550,7 @@ def chart_command(
         typer.Option("--ukc", metavar="M", help="Under-keel clearance added to the draught (m)."),
     ] = 0.0,
     out: Annotated[
-        Path | None,
+        str | None,  # as typed: see _out_file
         typer.Option(
             "--out",
             metavar="FILE.png|FILE.gpkg",
@@ -567,7 +581,7 @@ def chart_command(
             charts,
             draught_m=draught,
             ukc_m=ukc,
-            out=out,
+            out=_out_file(out),
             quiet=quiet,
             accept_gaps=accept_chart_gaps,
         )

@@ -3,6 +3,9 @@ available": never in the statistics, never an error in the replay."""
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 import warnings
 from pathlib import Path
 
@@ -11,11 +14,15 @@ import pyarrow as pa
 import pytest
 
 from colregs9_cli.ais.load import load_ais
+from colregs9_cli.ais.schema import CANONICAL_SCHEMA
 from colregs9_cli.replay import run_replay
 from colregs9_cli.stats import run_stats
 from colregs9_cli.vessel_defaults import vessel_dimensions
 
-from fixture_files import DMA26
+from fixture_files import AIS_FIXTURES, DMA26, MARINECADASTRE, ROOT
+
+AISHUB = AIS_FIXTURES / "aishub_sample.csv"
+MAPS = ROOT / "examples" / "column_maps"
 
 
 def _with_length(tmp_path: Path, value: str) -> Path:
@@ -213,13 +220,115 @@ def test_the_ledger_counts_dropped_values_apart_from_the_balance() -> None:
     assert "values_dropped" not in RejectsLedger().to_dict()  # unchanged without any
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="ais/load.py must count DimensionColumns.implausible() in its ledger (RejectsLedger"
-    ".drop); it is another developer's file",
-)
 def test_load_counts_implausible_dimensions_in_the_ledger(tmp_path: Path) -> None:
     path = _with_length(tmp_path, "900")
     ledger = load_ais([path]).ledger
     assert ledger.balanced
-    assert ledger.dropped["implausible_dimension"] == ledger.rows_read
+    # every row past the mobile-type and MMSI checks (the duplicate too, found later)
+    assert ledger.rejects == {"not_a_vessel": 1, "duplicate": 1}
+    assert ledger.dropped["implausible_dimension"] == ledger.rows_read - 1
+    (example, *_) = ledger.dropped_examples["implausible_dimension"]
+    assert example.startswith(f"{path}:2: implausible dimension dropped (length 900 m)")
+
+
+# -- every reader's path, through `colregs9 stats` and its run.json ------------------------------
+
+
+def _one_row_changed(source: Path, target: Path, values: dict[str, str]) -> Path:
+    """``source`` with the first data row's ``values`` (columns by name) replaced."""
+    lines = source.read_text(encoding="utf-8").splitlines()
+    delimiter = ";" if lines[0].count(";") > lines[0].count(",") else ","
+    header = lines[0].lstrip("# ").split(delimiter)
+    fields = lines[1].split(delimiter)
+    for name, value in values.items():
+        fields[header.index(name)] = value
+    target.write_text("\n".join([lines[0], delimiter.join(fields), *lines[2:]]) + "\n")
+    return target
+
+
+def _dma(tmp_path: Path) -> tuple[list[str], str]:
+    path = _one_row_changed(DMA26, tmp_path / "dma.csv", {"Length": "900", "A": ""})
+    return [path.name], "dma.csv:2: implausible dimension dropped (length 900 m): MMSI 257739000"
+
+
+def _dma_breadth_inf(tmp_path: Path) -> tuple[list[str], str]:
+    path = _one_row_changed(DMA26, tmp_path / "dma_inf.csv", {"Width": "1e400", "C": ""})
+    return [path.name], "dma_inf.csv:2: implausible dimension dropped (breadth inf m)"
+
+
+def _marinecadastre(tmp_path: Path) -> tuple[list[str], str]:
+    path = _one_row_changed(MARINECADASTRE, tmp_path / "mc.csv", {"Length": "600"})
+    return [path.name], "mc.csv:2: implausible dimension dropped (length 600 m): MMSI 367752440"
+
+
+def _mapped(tmp_path: Path) -> tuple[list[str], str]:
+    """A column map (AISHub's): length as A+B, in metres."""
+    path = _one_row_changed(AISHUB, tmp_path / "aishub.csv", {"A": "400", "B": "200"})
+    return (
+        [path.name, "--columns", str(MAPS / "aishub.toml")],
+        "aishub.csv:2: implausible dimension dropped (length 600 m): MMSI 367752440",
+    )
+
+
+def _nmea(tmp_path: Path) -> tuple[list[str], str]:
+    """AIS encodes A+B up to 1022 m and C+D up to 126 m: decoded, then dropped."""
+    from pyais import encode_dict
+
+    position = {"type": 1, "mmsi": 219000001, "lat": 57.05, "lon": 9.92}
+    static = {"type": 5, "mmsi": 219000001, "ship_type": 70, "to_bow": 511, "to_stern": 511}
+    static |= {"to_port": 4, "to_starboard": 6, "draught": 5.2, "shipname": "LONG SHIP"}
+    lines = [f"{s},1384257600" for s in encode_dict(position, radio_channel="A")]
+    lines += [f"{s},1384257601" for s in encode_dict(static, radio_channel="A", seq_id=1)]
+    path = tmp_path / "log.nmea"
+    path.write_text("\n".join(lines) + "\n")
+    return [path.name], "log.nmea:2: implausible dimension dropped (length 1022 m): MMSI 219000001"
+
+
+def _parquet(tmp_path: Path) -> tuple[list[str], str]:
+    import pyarrow.parquet as pq
+
+    from colregs9_cli.ais.load import load_ais as load
+
+    table = pa.Table.from_pandas(
+        load([DMA26]).positions, schema=CANONICAL_SCHEMA, preserve_index=False
+    )
+    lengths = table.column("length_m").to_pylist()
+    lengths[0] = 600.0
+    table = table.set_column(
+        table.schema.get_field_index("length_m"), "length_m", pa.array(lengths)
+    )
+    path = tmp_path / "canonical.parquet"
+    pq.write_table(table, path)
+    return [path.name], "canonical.parquet: implausible dimension dropped (length 600 m): MMSI"
+
+
+@pytest.mark.parametrize(
+    "make", [_dma, _dma_breadth_inf, _marinecadastre, _mapped, _nmea, _parquet]
+)
+def test_stats_counts_the_implausible_dimension_of_each_reader(tmp_path: Path, make) -> None:  # type: ignore[no-untyped-def]
+    args, example = make(tmp_path)
+    done = subprocess.run(
+        [sys.executable, "-m", "colregs9_cli", "stats", *args, "--out", "out", "--quiet"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        check=False,
+        timeout=120,
+    )
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    ledger = json.loads((tmp_path / "out" / "run.json").read_text())["ledger"]
+    assert ledger["values_dropped"] == {"implausible_dimension": 1}
+    (found,) = ledger["values_dropped_examples"]["implausible_dimension"]
+    assert found.startswith(example), found
+    assert ledger["rows_read"] == (
+        ledger["rows_used"] + ledger["rows_outside_query"] + ledger["rows_rejected"]
+    )
+
+
+def test_a_dataset_keeps_the_count_of_its_inputs(tmp_path: Path) -> None:
+    from colregs9_cli.ais.dataset import ingest
+
+    path = _with_length(tmp_path, "900")
+    ingest([path], tmp_path / "ais")
+    from_dataset = load_ais([tmp_path / "ais"]).ledger
+    assert from_dataset.dropped == load_ais([path]).ledger.dropped != {}

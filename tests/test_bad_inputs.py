@@ -34,7 +34,7 @@ import pytest
 
 from colregs9_cli.ais.schema import CANONICAL_SCHEMA
 
-from fixture_files import DEMO_DATA, DMA26, MARINECADASTRE, MODELLED_CHART, NMEA, ROOT
+from fixture_files import DEMO_DATA, DMA22, DMA26, MARINECADASTRE, MODELLED_CHART, NMEA, ROOT
 
 ANNAPOLIS_ENC = ROOT / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
 DRIVER = Path(__file__).with_name("cli_driver.py")
@@ -403,17 +403,6 @@ def _datasets(work: Path) -> dict[str, str]:
     }
 
 
-# Inputs with no usable AIS row (none at all, or every one rejected): ingest should refuse
-# them as stats and replay do (exit 2, naming the file), but colregs9_cli/ais/dataset.py (not
-# in this change) writes "0 rows written" and exits 0.
-INGEST_ZERO_ROWS = (
-    "ingest-ais-nmea_gps_only",
-    "ingest-ais-nmea_bad_checksums",
-    "ingest-ais-all_rows_bad_mmsi",
-    "ingest-zero-rows-parquet",
-)
-
-
 def _ingest_cases(
     work: Path, ais: dict[str, str], datasets: dict[str, str], a_file: str, good: str
 ) -> list[Case]:
@@ -466,6 +455,26 @@ def _ingest_cases(
             ("ingest", good, "--out", "foreign", "--quiet"),
             2,
             "not a colregs9 dataset",
+        ),
+        # A dataset --out is checked as stats and replay check it, before any input is read:
+        # for an input already in it, and for a new one.
+        Case(
+            "ingest-into-dataset-foreign-parquet",
+            ("ingest", good, "--out", datasets["foreign"], "--quiet"),
+            2,
+            "foreign.parquet",
+        ),
+        Case(
+            "ingest-new-input-into-dataset-foreign-parquet",
+            ("ingest", str(DMA22), "--out", datasets["foreign"], "--quiet"),
+            2,
+            "foreign.parquet",
+        ),
+        Case(
+            "ingest-into-dataset-wrong-schema",
+            ("ingest", str(DMA22), "--out", datasets["wrong_schema_dir"], "--quiet"),
+            2,
+            datasets["wrong_schema"],
         ),
         Case(
             "ingest-a-dataset-as-input",
@@ -668,6 +677,31 @@ def _cases(work: Path) -> list[Case]:
             ("chart", str(MODELLED_CHART), "--draught", "2", "--out", "plot_dir.png"),
             2,
             "plot_dir.png: --out is a directory",
+        ),
+        # Path() would drop the trailing separator and write trail.png.
+        Case(
+            "chart-out-trailing-slash",
+            ("chart", str(MODELLED_CHART), "--draught", "2", "--out", "trail.png/"),
+            2,
+            "trail.png/: --out ends in a path separator",
+        ),
+        Case(
+            "chart-out-gpkg-trailing-slash",
+            ("chart", str(MODELLED_CHART), "--draught", "2", "--out", "out/chart.gpkg/"),
+            2,
+            "out/chart.gpkg/: --out ends in a path separator",
+        ),
+        Case(
+            "simulate-out-trailing-slash",
+            (
+                "simulate",
+                str(DEMO_DATA / "greenhopper_restricted.toml"),
+                "--out",
+                "sim.csv/",
+                "--quiet",
+            ),
+            2,
+            "sim.csv/: --out ends in a path separator",
         ),
         Case(
             "simulate-out-a-fifo",
@@ -907,20 +941,7 @@ def _check(case: Case, code: object, stdout: str, stderr: str, escaped: object, 
     assert case.names in errors[0], errors[0]
 
 
-@pytest.mark.parametrize(
-    "case_id",
-    [
-        pytest.param(
-            case_id,
-            marks=pytest.mark.xfail(
-                strict=True, reason="ingest of zero AIS rows: a fix in ais/dataset.py"
-            ),
-        )
-        if case_id in INGEST_ZERO_ROWS
-        else case_id
-        for case_id in CASE_IDS
-    ],
-)
+@pytest.mark.parametrize("case_id", CASE_IDS)
 def test_bad_input(case_id: str, cases, results, work: Path) -> None:
     case = cases[case_id]
     result = results[case_id]

@@ -131,6 +131,15 @@ def test_an_out_without_a_draught_is_refused(tmp_path: Path, name: str) -> None:
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("name", ["trail.png/", "trail.gpkg/", "trail.png//"])
+def test_an_out_ending_in_a_separator_names_a_directory(tmp_path: Path, name: str) -> None:
+    """Path() would drop the separator and write trail.png: the option is read as typed."""
+    result = _run("chart", str(ENC), "--draught", "5", "--out", f"{tmp_path}/{name}", "--quiet")
+    _one_error_line(result, name, "--out ends in a path separator", "names a directory")
+    assert result.exit_code == 2
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_an_out_under_a_file_is_refused(tmp_path: Path) -> None:
     (tmp_path / "file").write_text("x")
     result = _run("chart", str(ENC), "--draught", "5", "--out", str(tmp_path / "file" / "c.gpkg"))

@@ -298,18 +298,64 @@ def _corrupt_manifest(directory: Path) -> str:
     return "not valid JSON"
 
 
+@pytest.mark.parametrize("command", ["stats", "ingest"])
 @pytest.mark.parametrize("spoil", [_foreign, _wrong_schema, _no_manifest, _corrupt_manifest])
-def test_a_bad_dataset_gives_one_error_line(tmp_path: Path, spoil) -> None:  # type: ignore[no-untyped-def]
+def test_a_bad_dataset_gives_one_error_line(tmp_path: Path, spoil, command: str) -> None:  # type: ignore[no-untyped-def]
+    """stats reads the dataset, ingest adds to it (a new input and one already in it): each
+    checks it whole first, and ingest leaves it as it was."""
     out = tmp_path / "ais"
     ingest([DMA26], out)
     needle = spoil(out)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        result = CliRunner().invoke(app, ["stats", str(out), "--out", str(tmp_path / "s")])
+    before = _snapshot(tmp_path)
+    runs = (
+        [["stats", str(out), "--out", str(tmp_path / "s")]]
+        if command == "stats"
+        else [["ingest", str(path), "--out", str(out), "--quiet"] for path in (DMA22, DMA26)]
+    )
+    for args in runs:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            result = CliRunner().invoke(app, args)
+        assert result.exit_code == 2, result.output
+        lines = result.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("Error: "), result.output
+        assert needle in lines[0] and str(out) in lines[0]
+    if command == "ingest":
+        assert _snapshot(tmp_path) == before
+
+
+def test_ingest_refuses_an_input_without_any_usable_row(tmp_path: Path) -> None:
+    """As stats and replay refuse it: one Error line naming the file (exit 2), and nothing
+    of it in the dataset; the inputs before it stay ingested."""
+    gps_only = tmp_path / "gps.nmea"
+    gps_only.write_text("$GPGGA,120000,5700.000,N,01000.000,E,1,08,0.9,10.0,M,,M,,*4F\n")
+    out = tmp_path / "ais"
+    result = CliRunner().invoke(
+        app, ["ingest", str(DMA26), str(gps_only), "--out", str(out), "--quiet"]
+    )
     assert result.exit_code == 2, result.output
     lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("Error: "), result.output
-    assert needle in lines[0] and str(out) in lines[0]
+    assert len(lines) == 1 and lines[0].startswith(f"Error: {gps_only}: no valid AIS position")
+    (item,) = Dataset.open(out).inputs
+    assert Path(item.path) == DMA26
+    assert not list(out.glob(".ingest-*"))
+
+
+def test_ingest_keeps_an_input_whose_rows_are_all_outside_its_query(tmp_path: Path) -> None:
+    """Valid AIS that the ingest query does not select is no error (its static reports,
+    which have no position, are kept)."""
+    query = tmp_path / "elsewhere.toml"
+    query.write_text(
+        'name = "elsewhere"\n[region]\nlat_min = -10.0\nlat_max = -9.0\n'
+        "lon_min = 0.0\nlon_max = 1.0\n"
+    )
+    result = CliRunner().invoke(
+        app, ["ingest", str(DMA26), "--query", str(query), "--out", str(tmp_path / "ais")]
+    )
+    assert result.exit_code == 0, result.output
+    (item,) = Dataset.open(tmp_path / "ais").inputs
+    assert item.ledger.rows_outside_query > 0
+    assert item.ledger.rows_used == sum(f.rows for f in item.files)
 
 
 @pytest.mark.parametrize("target", ["file", "foreign directory"])

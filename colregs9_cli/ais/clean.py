@@ -269,6 +269,21 @@ def implausible(dimensions: Dimensions) -> BoolArray:
     return np.asarray(beyond[0] | beyond[1] | beyond[2], dtype=bool)
 
 
+def implausible_text(length_m: float, breadth_m: float, draught_m: float) -> str:
+    """The dimensions of one row that ``plausible`` drops, for the ledger's examples
+    (``length 900 m, draught inf m``)."""
+    return ", ".join(
+        f"{name} {value:g} m"
+        for name, value, limit_m in zip(
+            ("length", "breadth", "draught"),
+            (length_m, breadth_m, draught_m),
+            _LIMITS_M,
+            strict=True,
+        )
+        if value > 0.0 and not value <= limit_m
+    )
+
+
 @dataclass(frozen=True)
 class DimensionColumns:
     """A block's dimension columns as read, one row per row, and ``clean``, which turns
@@ -284,18 +299,25 @@ class DimensionColumns:
     def of_rows(self, rows: NDArray[np.int64]) -> Dimensions:
         return self.clean(self.table.take(pa.array(rows, pa.int64())))
 
-    def implausible(self, table: pa.Table | None = None) -> BoolArray:
-        """Which rows of ``table`` (columns as ``self.table``'s, more may follow; default
-        ``self.table``) report a dimension that cleaning drops as implausible: beyond the
-        module limits or not finite. The reader's own cleaning is run again with the limits
-        lifted, so that every layout's way of making a dimension (A+B, or Length) counts."""
+    def unbounded(self, table: pa.Table | None = None) -> Dimensions:
+        """The reader's own cleaning of ``table`` (columns as ``self.table``'s, more may
+        follow; default ``self.table``) with the module limits lifted: every layout's way
+        of making a dimension (A+B, or Length), before the implausible values are dropped."""
         rows = self.table if table is None else table
         token = _limits_m.set((math.inf, math.inf, math.inf))
         try:
-            unbounded = self.clean(rows)
+            return self.clean(rows)
         finally:
             _limits_m.reset(token)
-        return implausible(unbounded)
+
+    def unbounded_rows(self, rows: NDArray[np.int64]) -> Dimensions:
+        """``unbounded`` for some rows of ``self.table`` (indices)."""
+        return self.unbounded(self.table.take(pa.array(rows, pa.int64())))
+
+    def implausible(self, table: pa.Table | None = None) -> BoolArray:
+        """Which rows of ``table`` (as for ``unbounded``) report a dimension that cleaning
+        drops as implausible: beyond the module limits or not finite."""
+        return implausible(self.unbounded(table))
 
     def implausible_rows(self, rows: NDArray[np.int64]) -> BoolArray:
         """``implausible`` for some rows of ``self.table`` (indices)."""

@@ -72,7 +72,15 @@ from .dataset_scan import (
     utc_ms,
 )
 from .ledger import RejectReason, RejectsLedger
-from .load import check_format, ingest_params, rows_in_query, scan_columns, stream_ais
+from .load import (
+    InputFile,
+    check_format,
+    ingest_params,
+    no_positions_error,
+    rows_in_query,
+    scan_columns,
+    stream_ais,
+)
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from .sources import Source, inspect_source, sha256_file
 
@@ -131,10 +139,14 @@ def ingest(
     of every file. ``row_group_rows``: rows per Parquet row group.
 
     Raises ``OutputError`` for an ``out_dir`` that is a file or a non-empty directory that
-    is not a dataset, ``InputFileError`` for unreadable inputs or a broken manifest.
+    is not a dataset, ``InputFileError`` for unreadable inputs, an input without any usable
+    AIS position (as ``load_ais`` refuses one, naming it; its rows are then not written,
+    those of the inputs before it are), or a dataset that ``Dataset.open`` refuses (a broken
+    manifest, a Parquet file it does not list, a file of another schema), checked before
+    any input is read.
     """
     query = load_query(query_path) if query_path is not None else everything_query()
-    return ingest_with_query(paths, out_dir, query, fmt, quiet, row_group_rows)
+    return ingest_with_query(paths, out_dir, query, fmt, quiet, row_group_rows, refuse_empty=True)
 
 
 def ingest_with_query(
@@ -144,8 +156,11 @@ def ingest_with_query(
     fmt: str | None = None,
     quiet: bool = True,
     row_group_rows: int = ROW_GROUP_ROWS,
+    refuse_empty: bool = False,
 ) -> IngestResult:
-    """``ingest`` with the query already loaded (replay ingests its files this way)."""
+    """``ingest`` with the query already loaded (replay ingests its files this way).
+    ``refuse_empty``: refuse an input without any usable AIS position (``ingest`` does;
+    replay refuses its inputs together, as ``load_ais`` does)."""
     check_format(fmt)
     if row_group_rows < 1:
         raise ParameterError(f"row_group_rows {row_group_rows}: give 1 or more")
@@ -158,6 +173,8 @@ def ingest_with_query(
     known = {entry["sha256"]: entry for entry in entries}
     hashes = [sha256_file(source.path) for source in sources]
     new = {h: s for s, h in zip(sources, hashes, strict=True) if h not in known}
+    if is_dataset(out_dir):  # as stats and replay check it: no file it does not list
+        Dataset.open(out_dir, leftovers=[f"{_prefix(h)}-" for h in new])
     if new:
         try:
             out_dir.mkdir(parents=True, exist_ok=True)
@@ -170,7 +187,9 @@ def ingest_with_query(
             if sha256 in known:
                 results.append(_already(source.path, known[sha256]))
                 continue
-            entry = _ingest_one(source, sha256, out_dir, query, fmt, bar, row_group_rows, quiet)
+            entry = _ingest_one(
+                source, sha256, out_dir, query, fmt, bar, row_group_rows, quiet, refuse_empty
+            )
             entries.append(entry)
             known[sha256] = entry
             _write_manifest(out_dir, entries)
@@ -212,9 +231,12 @@ def _ingest_one(
     bar: ProgressSink,
     row_group_rows: int,
     quiet: bool,
+    refuse_empty: bool = False,
 ) -> dict[str, Any]:
     """Read one input into a staging directory, then move its files into the dataset;
-    the manifest entry for it."""
+    the manifest entry for it. ``refuse_empty``: ``InputFileError`` for an input without
+    any usable AIS position (none written, none outside the query; static reports alone
+    are none, as ``load_ais`` tells), before anything is moved."""
     try:
         staging = out_dir / f".ingest-{secrets.token_hex(6)}"
         staging.mkdir()
@@ -228,12 +250,17 @@ def _ingest_one(
                 f"{source.name}: the file changed while it was being ingested; ingest it again "
                 "once it is complete"
             )
-        prefix = f"part-{sha256[:16]}"
+        prefix = _prefix(sha256)
         hours = len(spill.files)
         with progress_bar("Writing partitions (hours)", hours, progress_enabled(quiet)) as done:
             written = _write_partitions(
                 spill, staging / "out", prefix, row_group_rows, streamed.ledger, done
             )
+        ledger = streamed.ledger
+        positions = sum(item.rows - item.static_rows for item in written)
+        if refuse_empty and not positions and not ledger.rows_outside_query:
+            read = InputFile(source.path, sha256, streamed.layout, ledger.rows_read)
+            raise no_positions_error([read], ledger, query)
         _install(staging / "out", out_dir, prefix, written)
     except OSError as exc:
         raise _output_error(out_dir, exc) from None
@@ -465,6 +492,11 @@ def _drop_duplicates(table: pa.Table) -> tuple[pa.Table, pa.Table]:
     dropped = np.zeros(table.num_rows, dtype=bool)
     dropped[candidates[repeated]] = True
     return table.filter(pa.array(~dropped)), table.filter(pa.array(dropped))
+
+
+def _prefix(sha256: str) -> str:
+    """The start of the names of an input's files (``part-<sha16>``)."""
+    return f"part-{sha256[:16]}"
 
 
 def _install(staging: Path, out_dir: Path, prefix: str, written: list[_Written]) -> None:

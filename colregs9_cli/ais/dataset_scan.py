@@ -160,14 +160,22 @@ class Dataset:
     static_rows: int  # rows without a position (static reports), from the footers
 
     @classmethod
-    def open(cls, directory: Path) -> Dataset:
+    def open(cls, directory: Path, leftovers: Sequence[str] = ()) -> Dataset:
+        """Open and check the dataset ``directory``: ``InputFileError`` naming the first
+        file that does not agree with the manifest. ``leftovers``: file name prefixes
+        (``part-<sha16>-``) of inputs an ingest is about to write again, whose unlisted files
+        an interrupted ingest may have left (the ingest replaces them)."""
         directory = Path(directory)
         inputs = tuple(read_manifest(directory))
         listed = [f for item in inputs for f in item.files]
         names = {f.path for f in listed}
         for found in sorted(directory.rglob("*.parquet")):
             relative = found.relative_to(directory)
-            if relative.as_posix() not in names and not _hidden(relative):
+            if (
+                relative.as_posix() not in names
+                and not _hidden(relative)
+                and not found.name.startswith(tuple(leftovers))
+            ):
                 raise InputFileError(
                     f"{found}: a Parquet file the dataset manifest does not list (a dataset "
                     "holds only what colregs9 ingest wrote); move it out of the dataset, or "

@@ -78,6 +78,7 @@ from .clean import (
     Fields,
     any_dimension,
     clean_text,
+    implausible_text,
     is_vessel,
     null_outside,
     plausible,
@@ -89,7 +90,7 @@ from .columns import file_map
 from .csv_chunks import CsvChunk, CutRows, NotUtf8, ParsedRows, parse_cut_rows
 from .csv_read import CsvReading, missing_columns
 from .detect import LAYOUTS, csv_header, detect_layout, is_csv_layout, known_layout
-from .ledger import RejectReason, RejectsLedger
+from .ledger import DropReason, RejectReason, RejectsLedger
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from .sources import (
     Source,
@@ -515,12 +516,25 @@ class _FileResult:
             self.kept.append(table.filter(pa.array(selected)))
 
     def add_dimensions(
-        self, mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray
+        self,
+        mmsi: np.ndarray,
+        dimensions: DimensionColumns,
+        rows: np.ndarray,
+        example: Example | None = None,
     ) -> None:
-        """Count the dimensions reported by ``rows`` (a mask); rows without any are left out."""
+        """Count the dimensions reported by ``rows`` (a mask); rows without any are left out.
+        Rows with a dimension dropped as implausible are counted in the ledger
+        (``implausible_dimension``), quoted by ``example(row, "MMSI", why)``."""
         if not rows.any():
             return
-        self._add_counts(_count_reports(mmsi, dimensions, rows))
+        counts, implausible = _count_reports(mmsi, dimensions, rows)
+        self._add_counts(counts)
+        if implausible:
+            reason = DropReason.IMPLAUSIBLE_DIMENSION
+            sample = None
+            if example is not None and self.ledger.wants_example(reason):
+                sample = _implausible_example(dimensions, rows, example)
+            self.ledger.drop(reason, implausible, example=sample)
 
     def _uncount_dimensions(self, rows: pa.Table) -> None:
         """Take back the dimensions counted for canonical ``rows`` that were rejected after
@@ -545,10 +559,13 @@ class _FileResult:
             self.dimension_parts = [_sum_counts(self.dimension_parts)]
 
 
-def _count_reports(mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray) -> pa.Table:
+def _count_reports(
+    mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndarray
+) -> tuple[pa.Table, int]:
     """The reports (``_report_rows``) of the cleaned dimensions of ``rows``, without the
-    rows that report none. The rows are grouped as read first, and only the groups are
-    cleaned; groups that clean alike are summed later."""
+    rows that report none, and how many of ``rows`` have a dimension dropped as implausible.
+    The rows are grouped as read first, and only the groups are cleaned; groups that clean
+    alike are summed later."""
     key = "mmsi"
     while key in dimensions.table.column_names:
         key = f"_{key}"
@@ -557,13 +574,25 @@ def _count_reports(mmsi: np.ndarray, dimensions: DimensionColumns, rows: np.ndar
     groups = groups.filter(pc.not_equal(groups.column(key), -1))
     length_m, breadth_m, draught_m = dimensions.clean(groups)
     reported = any_dimension(length_m, breadth_m, draught_m)
-    return _report_rows(
+    times = groups.column("count_all").to_numpy()
+    implausible = int(times[dimensions.implausible(groups)].sum())
+    counts = _report_rows(
         groups.column(key).to_numpy()[reported],
         length_m[reported],
         breadth_m[reported],
         draught_m[reported],
-        groups.column("count_all").to_numpy()[reported],
+        times[reported],
     )
+    return counts, implausible
+
+
+def _implausible_example(dimensions: DimensionColumns, rows: np.ndarray, example: Example) -> str:
+    """The first of ``rows`` (a mask) with an implausible dimension, quoted with its values."""
+    candidates = np.flatnonzero(rows)
+    first = int(candidates[np.argmax(dimensions.implausible_rows(candidates))])
+    length_m, breadth_m, draught_m = dimensions.unbounded_rows(np.array([first]))
+    what = implausible_text(float(length_m[0]), float(breadth_m[0]), float(draught_m[0]))
+    return example(first, "MMSI", f"implausible dimension dropped ({what}): MMSI")
 
 
 def _report_rows(
@@ -819,7 +848,7 @@ def _classify(
 
     # Every row past these checks counts: one without a position or a dimension adds
     # nothing, and a kept row whose timestamp does not parse is taken back when settled.
-    result.add_dimensions(fields.mmsi, fields.dimensions, left)
+    result.add_dimensions(fields.mmsi, fields.dimensions, left, example)
     no_position = left & (np.isnan(fields.lat_deg) | np.isnan(fields.lon_deg))
     if no_position.any():
         rows = np.flatnonzero(no_position)
@@ -947,7 +976,7 @@ def _table_example(name: str, table: pa.Table) -> Example:
         value = table.column(column)[row].as_py()
         mmsi = table.column("mmsi")[row].as_py()
         if what == "MMSI":
-            return f"{name}: MMSI {mmsi}"
+            return f"{name}: {why} {mmsi}"
         return f"{name}: MMSI {mmsi}: {why} {value!r}"
 
     return example
@@ -1046,7 +1075,7 @@ def _nmea_batch(result: _FileResult, batch: AisBatch) -> None:
         )
     result.ledger.use(int((~bad).sum()))
     dimensions = DimensionColumns(statics.select(list(DIMENSIONS)), _canonical_dimensions)
-    result.add_dimensions(mmsi, dimensions, ~bad)
+    result.add_dimensions(mmsi, dimensions, ~bad)  # implausible ones were counted in nmea.py
     if result.sink is not None and not bad.all():
         result.sink.statics(_statics_canonical(statics.filter(pa.array(~bad))))
 

@@ -58,7 +58,10 @@ Not available -> null: lat outside ±90 (91), lon outside ±180 (181), SOG 102.3
 COG and heading 360 and above (360, 511; type 27: 511), rate of turn -128 and ±127 (turning
 fast with no turn indicator: no rate is known), dimension 0, draught 0, ship type 0, IMO 0,
 empty text. The rate of turn is (raw / 4.733)² deg/min with the sign of raw. Type 27 (the
-long-range broadcast of SOLAS ships) is "Class A".
+long-range broadcast of SOLAS ships) is "Class A". A length (A+B) or breadth (C+D) beyond
+what ships have (``clean.MAX_LENGTH_M``, ``MAX_BREADTH_M``) is dropped too, and its message
+(with a valid MMSI) counted in the ledger as ``implausible_dimension`` (AIS cannot encode a
+draught beyond ``MAX_DRAUGHT_M``).
 """
 
 from __future__ import annotations
@@ -90,8 +93,16 @@ from pyais.messages import (
 
 from ..errors import ParameterError
 from .batch import STATIC_SCHEMA, AisBatch
-from .clean import MAX_BREADTH_M, MAX_LENGTH_M, SHIP_TYPE_CATEGORIES, null_outside
-from .ledger import RejectReason, RejectsLedger
+from .clean import (
+    MAX_BREADTH_M,
+    MAX_LENGTH_M,
+    SHIP_TYPE_CATEGORIES,
+    implausible,
+    implausible_text,
+    null_outside,
+    valid_mmsi,
+)
+from .ledger import DropReason, RejectReason, RejectsLedger
 from .schema import CANONICAL_SCHEMA
 
 POSITION_TYPES = frozenset({1, 2, 3, 18, 19, 27})
@@ -219,6 +230,7 @@ class _Columns:
     """Decoded values as plain lists; sentinels are nulled later, on whole arrays."""
 
     timestamp: list[int] = field(default_factory=list)  # milliseconds since the epoch
+    line_no: list[int] = field(default_factory=list)  # of the message's first sentence
     mmsi: list[int] = field(default_factory=list)
     msg_type: list[int] = field(default_factory=list)
     lat: list[float | None] = field(default_factory=list)
@@ -437,8 +449,10 @@ class _NmeaReader:
                 return
         if msg_type in POSITION_TYPES:
             self._add_position(cast(_PositionMessage, decoded), sentence, msg_type, timestamp)
+            self.positions.line_no.append(line_no)
         else:
             _append_static(self.statics, cast(_StaticMessage, decoded), msg_type, timestamp)
+            self.statics.line_no.append(line_no)
 
     def _add_position(
         self, decoded: _PositionMessage, sentence: AISSentence, msg_type: int, timestamp: int
@@ -598,6 +612,27 @@ def _null_where(values: np.ndarray, not_available: np.ndarray) -> np.ndarray:
 def _dimension(first: np.ndarray, second: np.ndarray) -> np.ndarray:
     """A+B (or C+D) only when both parts are reported; 0 means "not available"."""
     return np.where((first > 0) & (second > 0), first + second, np.nan)
+
+
+def _count_implausible(columns: _Columns, source_name: str, ledger: RejectsLedger) -> None:
+    """Count the messages of ``columns`` whose length or breadth ``_static_frame`` drops as
+    implausible, with a valid MMSI (the pipeline rejects the others): ``implausible_dimension``."""
+    dimensions = (
+        _dimension(_floats(columns.to_bow), _floats(columns.to_stern)),
+        _dimension(_floats(columns.to_port), _floats(columns.to_starboard)),
+        _floats(columns.draught),
+    )
+    flagged = implausible(dimensions) & valid_mmsi(np.array(columns.mmsi, dtype=np.int64))
+    if not flagged.any():
+        return
+    first = int(np.flatnonzero(flagged)[0])
+    what = implausible_text(*(float(values[first]) for values in dimensions))
+    ledger.drop(
+        DropReason.IMPLAUSIBLE_DIMENSION,
+        int(flagged.sum()),
+        example=f"{source_name}:{columns.line_no[first]}: implausible dimension dropped "
+        f"({what}): MMSI {columns.mmsi[first]}",
+    )
 
 
 def _text(values: list[str | None]) -> pd.Series:
@@ -767,6 +802,8 @@ def read_nmea(
     for line_no, line in enumerate(lines, start=1):
         reader.feed(line_no, line)
     reader.finish()
+    for columns in (reader.statics, reader.positions):  # positions: the type 19 fields
+        _count_implausible(columns, source_name, ledger)
     statics = _static_frame(reader.statics)
     # Type 19 positions carry static fields too; they fill other positions of that vessel.
     position_statics = _static_frame(reader.positions)
