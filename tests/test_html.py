@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from colregs9_cli.replay import run_replay
+from colregs9_cli.report.html_report import ENCOUNTER_TABLE_COLUMNS, pair_numbers
 from colregs9_cli.stats import run_stats
 
 from fixture_files import DMA26, NMEA
@@ -57,6 +58,20 @@ def _rows(dom: str) -> list[str]:
     return re.findall(r"<tr( class=\"hidden\")?>", body)
 
 
+def _cells(dom: str, column: str, shown_only: bool = True) -> list[str]:
+    """The text of one column's cells, in the rendered order (the shown rows only)."""
+    body = dom[dom.index('<table class="sortable" id="encounters">') :]
+    body = body[body.index("<tbody>") : body.index("</tbody>")]
+    index = ENCOUNTER_TABLE_COLUMNS.index(column)
+    cells = []
+    for hidden, row in re.findall(r"<tr( class=\"hidden\")?>(.*?)</tr>", body):
+        if hidden and shown_only:
+            continue
+        texts = [re.sub(r"<[^>]+>", "", cell) for cell in re.findall(r"<td[^>]*>(.*?)</td>", row)]
+        cells.append(texts[index])
+    return cells
+
+
 def test_replay_page_shows_every_encounter_and_figure(national_report, tmp_path) -> None:
     result, out = national_report
     page = out / "index.html"
@@ -77,12 +92,32 @@ def test_replay_page_filters_and_sorts_in_the_browser(national_report, tmp_path)
     result, out = national_report
     head_on = sum(o.summary.situation.value == "head-on" for o in result.encounters)
     assert 0 < head_on < len(result.encounters)
-    dom = rendered(out / "index.html", tmp_path, "?q=head-on&sort=9")
+    sort = ENCOUNTER_TABLE_COLUMNS.index("CPA (m)")
+    dom = rendered(out / "index.html", tmp_path, f"?q=head-on&sort={sort}")
     rows = _rows(dom)
     assert sum(hidden == "" for hidden in rows) == head_on
     assert f'<span id="encounters-shown">{head_on}</span>' in dom
-    cpas = [float(v) for v in re.findall(r'<td class="num" data-value="([^"]+)">', dom)[::2]]
-    assert cpas == sorted(cpas)
+    cpas = [float(v) for v in _cells(dom, "CPA (m)", shown_only=False)]
+    assert len(cpas) == len(result.encounters) and cpas == sorted(cpas)
+
+
+def test_a_pair_on_the_map_leads_to_its_rows_in_the_table(national_report, tmp_path) -> None:
+    result, out = national_report
+    numbers = pair_numbers(result)
+    page = (out / "index.html").read_text(encoding="utf-8")
+    # Each number on the map links to its pair...
+    for number in numbers.values():
+        assert f'<a xlink:href="#pair-{number}">' in page
+    # ...and the link shows that pair's rows (both seats), the table numbering them the same.
+    pair_id, number = sorted(numbers.items())[len(numbers) // 2]
+    dom = rendered(out / "index.html", tmp_path, f"#pair-{number}")
+    seats = [o.summary.encounter_id for o in result.encounters if o.summary.pair_id == pair_id]
+    assert len(seats) >= 1
+    assert sorted(_cells(dom, "encounter")) == sorted(seats)
+    assert set(_cells(dom, "pair")) == {str(number)}
+    assert f'<span id="encounters-shown">{len(seats)}</span>' in dom
+    every_pair = _cells(dom, "pair", shown_only=False)
+    assert sorted(set(every_pair), key=int) == [str(n) for n in range(1, len(numbers) + 1)]
 
 
 def test_a_missing_figure_is_marked_not_broken(national_report, tmp_path) -> None:

@@ -17,6 +17,7 @@ from colregs9_cli.replay import run_replay
 from colregs9_cli.replay_results import ENCOUNTER_COLUMNS, SERIES_COLUMNS
 from colregs9_cli.report.chart_plot import DEPTH_LABEL, RESTRICTED_COLOUR
 from colregs9_cli.report.replay_report import (
+    OUTLINES_PER_ARC,
     direction_arrows,
     encounter_figure,
     trigger_positions_m,
@@ -130,6 +131,33 @@ def test_index_links_resolve(run) -> None:
         assert (run.out_dir / link).is_file(), link
 
 
+def _page_links(out_dir) -> list[str]:
+    """The files index.html links to or shows (not its own anchors)."""
+    page = (out_dir / "index.html").read_text(encoding="utf-8")
+    return re.findall(r'(?:href|src)="([^"#][^"]*)"', page)
+
+
+def test_the_web_page_links_only_files_that_exist(run, tmp_path) -> None:
+    links = _page_links(run.out_dir)
+    assert {"report.gpkg", "encounters.csv", "pairs.csv", "run.json"} <= set(links)
+    for link in links:
+        assert (run.out_dir / link).is_file(), link
+    # No triggered encounter (a CPA of 1 m is never reached): no GeoPackage, so no link to it.
+    quiet = run_replay(
+        [NMEA],
+        own_mmsi=[OWN],
+        out_dir=tmp_path / "none",
+        plots=True,
+        overrides={"replay": {"cpa_req_m": 1.0}},
+    )
+    assert quiet.counts.triggered == 0
+    links = _page_links(quiet.out_dir)
+    assert "report.gpkg" not in links and {"encounters.csv", "run.json"} <= set(links)
+    for link in links:
+        assert (quiet.out_dir / link).is_file(), link
+    assert "<svg" not in (quiet.out_dir / "index.html").read_text(encoding="utf-8")
+
+
 def test_manifest(run) -> None:
     manifest = json.loads((run.out_dir / "run.json").read_text(encoding="utf-8"))
     assert {"version", "parameters", "inputs", "ledger", "counts", "frame"} <= set(manifest)
@@ -217,7 +245,14 @@ def _collection(ax, gid: str):
     return found[0] if found else None
 
 
-def test_figure_draws_one_ellipse_per_projected_position(restricted) -> None:
+def _drawn_every(assessment) -> int:
+    """1 in how many clear (or grey) ellipses along an arc the figure draws."""
+    every = int(np.ceil(assessment.step.max() / OUTLINES_PER_ARC))
+    assert len(assessment.arc) // 2 // every <= OUTLINES_PER_ARC
+    return every
+
+
+def test_figure_draws_every_red_ellipse_and_some_clear_ones(restricted) -> None:
     (outcome,) = restricted.encounters
     assessment = outcome.assessment
     chart = load_chart([MODELLED_CHART], restricted.frame)
@@ -226,8 +261,19 @@ def test_figure_draws_one_ellipse_per_projected_position(restricted) -> None:
     assert colour_bar.get_ylabel() == DEPTH_LABEL
     red = _collection(ax, "restricted-ellipses")
     blue = _collection(ax, "clear-ellipses")
+    every = _drawn_every(assessment)
+    assert every > 1  # 180 positions per arc: ~90 outlines would add up to an opaque band
+    clear = ~assessment.restricted & assessment.covered
     assert len(red.get_paths()) == int((assessment.restricted & assessment.covered).sum()) > 0
-    assert len(blue.get_paths()) == int((~assessment.restricted & assessment.covered).sum())
+    assert len(blue.get_paths()) == int((clear & (assessment.step % every == 0)).sum()) > 0
+    # the first clear one drawn is the projected position at step `every`
+    first = np.flatnonzero(clear & (assessment.step % every == 0))[0]
+    np.testing.assert_allclose(
+        blue.get_paths()[0].vertices[:-1],
+        np.asarray(assessment.ellipses[first].exterior.coords)[:-1],
+    )
+    assert blue.get_label() == f"clear ellipses (1 in {every} drawn)"
+    assert red.get_label() == "restricted ellipses"
     assert _collection(ax, "unknown-ellipses") is None
     # The chart background is there, with the navigable water for the target's 5 m draught.
     assert _collection(ax, "depth-areas") is not None
@@ -243,8 +289,10 @@ def test_figure_without_a_chart_marks_every_ellipse_unknown(run) -> None:
     figure = encounter_figure(outcome, chart=None, ukc_m=0.0, frame=run.frame)
     (ax,) = figure.axes
     unknown = _collection(ax, "unknown-ellipses")
-    assert len(unknown.get_paths()) == len(outcome.assessment.arc)
+    sampled = outcome.assessment.step % _drawn_every(outcome.assessment) == 0
+    assert len(unknown.get_paths()) == sampled.sum() > 0
     assert _collection(ax, "restricted-ellipses") is None
+    assert _collection(ax, "clear-ellipses") is None
     assert _collection(ax, "depth-areas") is None
 
 
@@ -335,10 +383,14 @@ def test_figure_layout_keeps_the_plot_clear(restricted) -> None:
     assert legend.get_window_extent(renderer).y1 <= ax.get_window_extent(renderer).y0
     labels = [t.get_text() for t in legend.get_texts()]
     assert {"own ship at trigger", "target at trigger", "restricted ellipses"} <= set(labels)
-    # The ellipses are drawn over the tracks.
-    track_zorder = _by_gid(ax, "own-track").get_zorder()
-    assert _collection(ax, "restricted-ellipses").get_zorder() > track_zorder
-    assert _collection(ax, "clear-ellipses").get_zorder() > track_zorder
+    # The tracks and their arrows are drawn over the ellipses, so that no band hides them.
+    ellipses = max(
+        _collection(ax, g).get_zorder() for g in ("restricted-ellipses", "clear-ellipses")
+    )
+    for gid in ("own-track", "target-track"):
+        assert _by_gid(ax, gid).get_zorder() > ellipses
+    for gid in ("own-direction", "target-direction"):
+        assert _collection(ax, gid).get_zorder() > ellipses
 
 
 def test_figure_names_the_vessels_and_marks_defaulted_dimensions(restricted) -> None:
@@ -389,17 +441,18 @@ def test_figure_axes_read_latitude_and_longitude_with_a_scale_bar(restricted) ->
     assert ellipses and all(0 < c.get_alpha() < 1 for c in ellipses)
 
 
-def test_figure_marks_where_the_data_ends_before_cpa(run) -> None:
+def test_figure_marks_where_each_track_ends(run) -> None:
     (outcome,) = run.encounters
-    stopped = dataclasses.replace(
-        outcome, summary=dataclasses.replace(outcome.summary, data_covers_cpa=False)
-    )
-    ax = encounter_figure(stopped, None, ukc_m=0.0, frame=run.frame).axes[0]
-    end = _by_gid(ax, "own-ship-data-end")
-    assert end.get_xdata()[0] == outcome.own_track["east_m"].dropna().iloc[-1]
-    assert _by_gid(ax, "target-data-end")
-    covered = dataclasses.replace(
-        outcome, summary=dataclasses.replace(outcome.summary, data_covers_cpa=True)
-    )
-    ax = encounter_figure(covered, None, ukc_m=0.0, frame=run.frame).axes[0]
-    assert not [line for line in ax.get_lines() if "data-end" in str(line.get_gid())]
+    for covers_cpa, note in ((False, "data ends (before CPA)"), (True, "end of track")):
+        shown = dataclasses.replace(
+            outcome, summary=dataclasses.replace(outcome.summary, data_covers_cpa=covers_cpa)
+        )
+        ax = encounter_figure(shown, None, ukc_m=0.0, frame=run.frame).axes[0]
+        for gid, name, track in (
+            ("own-ship-data-end", "own ship", outcome.own_track),
+            ("target-data-end", "target", outcome.target_track),
+        ):
+            end = _by_gid(ax, gid)
+            last = track.dropna().iloc[-1]
+            assert (end.get_xdata()[0], end.get_ydata()[0]) == (last["east_m"], last["north_m"])
+            assert end.get_label() == f"{name} {note}"

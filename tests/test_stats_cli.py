@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from matplotlib.colors import to_hex
 from matplotlib.patches import Rectangle
 from pyais.stream import IterMessages
 from typer.testing import CliRunner
@@ -428,3 +429,32 @@ def test_histograms_by_ship_type_are_stacked_by_type(tmp_path: Path) -> None:
             by_colour[colour] = by_colour.get(colour, 0) + bar.get_height()
         counts = sorted(g.row(dimension).count for g in groups.values() if g.row(dimension).count)
         assert sorted(by_colour.values()) == counts
+
+
+def test_histograms_by_ship_type_plot_each_type_in_one_colour(tmp_path: Path) -> None:
+    # In this sample the SAR vessels report a length but no draught.
+    run = run_stats([DMA26], per=Per.VESSEL, by=GroupBy.SHIP_TYPE, out_dir=tmp_path)
+    table = pd.read_csv(tmp_path / "dimension_stats.csv", dtype={"ship_type": str})
+    table = table[table["ship_type"] != "(all)"]
+    figure = histogram_figure(run.result, "all")
+    (legend,) = figure.legends
+    colours = {
+        text.get_text(): to_hex(handle.get_facecolor())
+        for text, handle in zip(legend.get_texts(), legend.legend_handles, strict=True)
+    }
+    # One legend for every type of the CSV, whichever panels a type has values in.
+    assert set(colours) == set(table["ship_type"])
+    assert len(set(colours.values())) == len(colours)
+    panels: dict[str, set[str]] = {}
+    for axis, dimension in zip(figure.axes, DIMENSIONS, strict=True):
+        rows = table[(table["dimension"] == dimension) & (table["count"] > 0)]
+        expected = dict(zip(rows["ship_type"], rows["count"], strict=True))
+        # Each stack is one type's vessels, in that type's legend colour.
+        plotted = {}
+        for stack in axis.containers:
+            plotted[stack.get_label()] = sum(bar.get_height() for bar in stack)
+            assert {to_hex(bar.get_facecolor()) for bar in stack} == {colours[stack.get_label()]}
+        assert plotted == expected, dimension
+        panels[dimension] = set(plotted)
+    # The case that shifted the colours: a type with a length but no draught.
+    assert panels["length_m"] - panels["draught_m"] == {"SAR"}

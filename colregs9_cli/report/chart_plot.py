@@ -2,8 +2,9 @@
 
 x is east (m), y is north (m), like the chart's geometry. The functions draw onto a given
 ``Axes`` so that the chart command and the replay report share them. Each collection gets a
-``gid`` (``depth-areas``, ``land``, ``navigable-water``, ``restricted-ellipses``,
-``clear-ellipses``, ``unknown-ellipses``) so that tests and callers can find what was drawn.
+``gid`` (``depth-areas``, ``land``, ``navigable-water``, ``not-charted``,
+``restricted-ellipses``, ``clear-ellipses``, ``unknown-ellipses``) so that tests and callers
+can find what was drawn.
 """
 
 from __future__ import annotations
@@ -39,14 +40,23 @@ UNKNOWN_COLOUR = "0.5"
 # The pale half of "Blues": deep water stays light enough for the blue (clear) ellipses.
 DEPTH_CMAP = ListedColormap(colormaps["Blues"](np.linspace(0.0, 0.45, 256)), name="depth")
 DEPTH_LABEL = "DRVAL1, shallowest depth (m)"
-# Drawing order: the chart at the bottom (0-2), then tracks drawn by callers (below 3), the
-# ellipses above any track, the restricted ones above the clear ones, and the arcs on top.
+# Drawing order: the chart at the bottom (0-2), then the ellipses, the restricted ones above
+# the clear ones, then the tracks drawn by callers (a band of ellipses must not hide them),
+# and the arcs on top.
 ELLIPSE_ZORDER = 3.0
 RESTRICTED_ZORDER = 3.2
+TRACK_ZORDER = 3.5
 ARC_ZORDER = 4.0
-ELLIPSE_LINEWIDTH = 0.6
-# Ellipses are half transparent, so that the tracks under them stay visible.
+ELLIPSE_LINEWIDTH = 0.5
+# Ellipses are half transparent, so that the chart under them stays readable.
 ELLIPSE_ALPHA = 0.45
+# Outside the chart's coverage: grey and hatched, unlike any depth or land colour, so that
+# it does not read as water too shallow to navigate.
+NOT_CHARTED_COLOUR = "#e6e6e6"
+NOT_CHARTED_HATCH_COLOUR = "0.55"
+NOT_CHARTED_LABEL = "not charted"
+# A view box: (min east, min north, max east, max north), in metres of the frame.
+Bounds = tuple[float, float, float, float]
 
 
 def _ring_path(coords: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -104,20 +114,31 @@ def depth_bands(need_m: float, drval1_m: np.ndarray) -> tuple[list[float], list[
     return edges, colours
 
 
+def _in_view(geometries: Any, view: Bounds | None) -> Any:
+    """The geometries cut to the view box (all at once): a figure of a harbour then draws a
+    few of the chart's polygons, not every one of them."""
+    return geometries if view is None else shapely.clip_by_rect(geometries, *view)
+
+
 def draw_chart(
     ax: Axes,
     chart: Chart,
     draught_m: float | None,
     ukc_m: float = 0.0,
     coverage: bool = False,
+    view: Bounds | None = None,
 ) -> Any:
     """Depth areas shaded by DRVAL1, land, and (with a draught) the navigable water outlined;
     with ``coverage``, the chart's edge (its coverage) dashed. With a draught the shading is
     in discrete bands around it (``depth_bands``), else continuous.
 
+    With a ``view`` box, only what lies in it is drawn, the axes show exactly it, and the
+    part of it outside the chart's coverage is hatched grey ("not charted"); without one,
+    the axes show the whole coverage.
+
     Returns the depth-area collection (a ScalarMappable, for a colour bar).
     """
-    patches, kept = _patches(chart.depth_areas)
+    patches, kept = _patches(_in_view(chart.depth_areas, view))
     drval1 = np.asarray(chart.drval1_m, dtype=float)[kept]
     if draught_m is None:
         depths = PatchCollection(patches, cmap=DEPTH_CMAP, edgecolor="none", zorder=0)
@@ -133,14 +154,14 @@ def draw_chart(
     depths.set_array(drval1)
     depths.set_gid("depth-areas")
     ax.add_collection(depths)
-    land_patches, _ = _patches([chart.land])
+    land_patches, _ = _patches([_in_view(chart.land, view)])
     land = PatchCollection(
         land_patches, facecolor=LAND_COLOUR, edgecolor="0.4", linewidth=0.3, zorder=1
     )
     land.set_gid("land")
     ax.add_collection(land)
     if draught_m is not None:
-        water_patches, _ = _patches([chart.navigable_water(draught_m, ukc_m)])
+        water_patches, _ = _patches([_in_view(chart.navigable_water(draught_m, ukc_m), view)])
         water = PatchCollection(
             water_patches,
             # Outlined, not filled: a tint would shift the depth colours off the colour bar.
@@ -165,15 +186,48 @@ def draw_chart(
         edge.set_gid("coverage")
         edge.set_label("chart edge (coverage): beyond it unknown")
         ax.add_collection(edge)
-    min_east, min_north, max_east, max_north = shapely.bounds(chart.coverage)
-    ax.update_datalim([(min_east, min_north), (max_east, max_north)])
-    ax.autoscale_view()
-    ax.set_aspect("equal", adjustable="datalim")
+    if view is None:
+        min_east, min_north, max_east, max_north = shapely.bounds(chart.coverage)
+        ax.update_datalim([(min_east, min_north), (max_east, max_north)])
+        ax.autoscale_view()
+        ax.set_aspect("equal", adjustable="datalim")
+        return depths
+    _draw_not_charted(ax, shapely.difference(shapely.box(*view), chart.coverage))
+    show_view(ax, view)
     return depths
 
 
-def draw_assessment(ax: Axes, assessment: ManoeuvrabilityAssessment) -> None:
-    """Both arcs, and each comfort zone red (restricted), blue (clear) or grey (off the chart)."""
+def _draw_not_charted(ax: Axes, outside: Any) -> None:
+    patches, _ = _patches([outside])
+    if not patches:
+        return
+    not_charted = PatchCollection(
+        patches,
+        facecolor=NOT_CHARTED_COLOUR,
+        edgecolor=NOT_CHARTED_HATCH_COLOUR,
+        hatch="///",
+        linewidth=0.0,
+        zorder=1.5,
+    )
+    not_charted.set_gid("not-charted")
+    not_charted.set_label(NOT_CHARTED_LABEL)
+    ax.add_collection(not_charted)
+
+
+def show_view(ax: Axes, view: Bounds) -> None:
+    """Show exactly the view box, at one scale in east and north."""
+    min_east, min_north, max_east, max_north = view
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlim(min_east, max_east)
+    ax.set_ylim(min_north, max_north)
+
+
+def draw_assessment(ax: Axes, assessment: ManoeuvrabilityAssessment, every: int = 1) -> None:
+    """Both arcs, and each comfort zone red (restricted), blue (clear) or grey (off the chart).
+
+    With ``every`` > 1, only every ``every``-th clear or grey outline along each arc is drawn
+    (every red one is): a hundred overlapping outlines add up to an opaque band.
+    """
     for arc, style in (("cw", "-"), ("ccw", "--")):
         on_arc = assessment.arc == arc
         ax.plot(
@@ -186,13 +240,20 @@ def draw_assessment(ax: Axes, assessment: ManoeuvrabilityAssessment) -> None:
             label=f"{arc} arc",
         )
     restricted = assessment.restricted & assessment.covered
-    clear = ~assessment.restricted & assessment.covered
+    sampled = assessment.step % every == 0
+    thinned = f" (1 in {every} drawn)" if every > 1 else ""
     groups = (
-        ("restricted-ellipses", restricted, RESTRICTED_COLOUR, RESTRICTED_ZORDER),
-        ("clear-ellipses", clear, CLEAR_COLOUR, ELLIPSE_ZORDER),
-        ("unknown-ellipses", ~assessment.covered, UNKNOWN_COLOUR, ELLIPSE_ZORDER),
+        ("restricted", restricted, RESTRICTED_COLOUR, RESTRICTED_ZORDER, ""),
+        (
+            "clear",
+            ~assessment.restricted & assessment.covered & sampled,
+            CLEAR_COLOUR,
+            ELLIPSE_ZORDER,
+            thinned,
+        ),
+        ("unknown", ~assessment.covered & sampled, UNKNOWN_COLOUR, ELLIPSE_ZORDER, thinned),
     )
-    for gid, selected, colour, zorder in groups:
+    for state, selected, colour, zorder, note in groups:
         if not selected.any():
             continue
         patches, _ = _patches(assessment.ellipses[selected])
@@ -204,8 +265,8 @@ def draw_assessment(ax: Axes, assessment: ManoeuvrabilityAssessment) -> None:
             alpha=ELLIPSE_ALPHA,
             zorder=zorder,
         )
-        ellipses.set_gid(gid)
-        ellipses.set_label(gid.replace("-", " "))
+        ellipses.set_gid(f"{state}-ellipses")
+        ellipses.set_label(f"{state} ellipses{note}")
         ax.add_collection(ellipses)
 
 

@@ -5,23 +5,25 @@ overview map (an inline SVG drawn by matplotlib from the data and the chart, no 
 the file; the per-encounter figures and the histograms are the PNG files beside it, linked
 relatively, so the report directory opens as it is, offline, from a disk or a file share.
 A figure that is missing (``--no-plots``, or a file moved) is marked on the page, not shown as
-a broken image.
+a broken image. The map numbers the pairs as the table's ``pair`` column does; a number on
+the map links to ``#pair-N``, which filters the table to that pair.
 """
 
 from __future__ import annotations
 
 import html
 import io
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
 from ..replay_results import EncounterOutcome, ReplayResult
-from .chart_plot import draw_chart
+from .chart_plot import Bounds, draw_chart, geographic_axes, show_view
 
 if TYPE_CHECKING:
     from ..chart import Chart
@@ -47,8 +49,9 @@ img.figure { max-width: 100%; border: 1px solid #ddd; }
 """
 
 # Sorts a table by a clicked header (numbers as numbers), filters its rows by the text box
-# and the selects, and marks figures that did not load.
-_SCRIPT = """
+# and the selects (a link to #pair-N sets the pair select), and marks figures that did not
+# load.
+_SCRIPT = r"""
 function cellValue(row, index) {
   const text = row.cells[index].dataset.value ?? row.cells[index].textContent;
   const number = Number(text);
@@ -92,12 +95,23 @@ document.addEventListener("DOMContentLoaded", () => {
     if (box) box.addEventListener("input", () => applyFilters(table));
     document.querySelectorAll("select[data-table='" + table.id + "']").forEach(s =>
       s.addEventListener("change", () => applyFilters(table)));
-    // A link can carry a filter and a sort: index.html?q=head-on&sort=9
+    // A link can carry a filter and a sort (a column number): index.html?q=head-on&sort=10
     const query = new URLSearchParams(location.search);
     if (box && query.has("q")) { box.value = query.get("q"); applyFilters(table); }
     if (query.has("sort")) sortBy(table.tHead.rows[0].cells[Number(query.get("sort"))]);
   });
+  selectPair();
 });
+function selectPair() {
+  const match = location.hash.match(/^#pair-(\d+)$/);
+  const select = document.querySelector("select[data-name='pair']");
+  if (!match || !select) return;
+  select.value = match[1];
+  const table = document.getElementById(select.dataset.table);
+  applyFilters(table);
+  table.scrollIntoView();
+}
+window.addEventListener("hashchange", selectPair);
 window.addEventListener("load", () => {
   document.querySelectorAll("img.figure").forEach(img => {
     if (!img.complete || img.naturalWidth === 0) {
@@ -166,13 +180,18 @@ def sortable_table(
         'placeholder="any text in the row"></label>'
     )
     for index in select_columns:
-        values = sorted({_text(row[index]) for row in rows})
+        # Numbers in numeric order (2 before 10), then text.
+        values = sorted(
+            {_text(row[index]) for row in rows},
+            key=lambda v: (0, int(v), "") if v.isdigit() else (1, 0, v),
+        )
         options = "".join(
             f'<option value="{html.escape(v)}">{html.escape(v)}</option>' for v in values
         )
         lines.append(
             f' <label>{html.escape(columns[index])}: <select data-table="{table_id}" '
-            f'data-column="{index}"><option value="">all</option>{options}</select></label>'
+            f'data-column="{index}" data-name="{html.escape(columns[index])}">'
+            f'<option value="">all</option>{options}</select></label>'
         )
     lines.append(
         f' <span><span id="{table_id}-shown">{len(rows)}</span> of {len(rows)} shown</span>'
@@ -195,6 +214,7 @@ def sortable_table(
 
 ENCOUNTER_TABLE_COLUMNS = (
     "encounter",
+    "pair",
     "trigger (UTC)",
     "own",
     "target",
@@ -209,17 +229,34 @@ ENCOUNTER_TABLE_COLUMNS = (
     "give-way acted",
 )
 # The table's columns offered as selects.
-_SELECTS = (4, 7, 8, 11, 12)
+_SELECTS = tuple(
+    ENCOUNTER_TABLE_COLUMNS.index(name)
+    for name in (
+        "pair",
+        "situation",
+        "rule 9",
+        "deciding rule",
+        "data covers CPA",
+        "give-way acted",
+    )
+)
 
 
 def _vessel(name: str | None, mmsi: int) -> str:
     return f"{name} ({mmsi})" if name else str(mmsi)
 
 
-def _encounter_row(outcome: EncounterOutcome) -> list[Any]:
+def pair_numbers(result: ReplayResult) -> dict[str, int]:
+    """Each triggered pair's number on the map and in the table: 1, 2, … in pairs.csv's
+    order."""
+    return {pair.summary.pair_id: number for number, pair in enumerate(result.pairs, start=1)}
+
+
+def _encounter_row(outcome: EncounterOutcome, numbers: Mapping[str, int]) -> list[Any]:
     s = outcome.summary
     return [
         s.encounter_id,
+        numbers[s.pair_id],
         s.trigger_utc,
         _vessel(s.own_name, s.own_mmsi),
         _vessel(s.target_name, s.target_mmsi),
@@ -245,47 +282,155 @@ def _facts(outcome: EncounterOutcome) -> list[str]:
     return lines
 
 
+# The overview map's margin around the trigger positions: a share of their spread, at least
+# a few hundred metres, so that the setting of a lone pair shows.
+MAP_MARGIN_SHARE = 0.1
+MAP_MIN_MARGIN_M = 500.0
+SITUATION_COLOURS = {"crossing": "tab:blue", "head-on": "tab:red", "overtaking": "tab:green"}
+# The map is 8 in high and as wide as its view needs (5 to 12 in), with these margins
+# (inches: left for the latitudes, right, bottom for the longitudes, top for the title),
+# so that a metre is the same number of points on the map however the view is shaped.
+MAP_HEIGHT_IN = 8.0
+MAP_MARGINS_IN = (1.1, 0.2, 0.9, 0.6)
+LABEL_POINTS = 7.0
+# Where a label may go: rings (points from its pair's position), 8 directions on each.
+LABEL_RADII_PT = (7.0, 14.0, 22.0, 32.0, 44.0, 58.0)
+
+
+def _map_view(east: np.ndarray, north: np.ndarray) -> Bounds:
+    margin = max(MAP_MARGIN_SHARE * max(np.ptp(east), np.ptp(north)), MAP_MIN_MARGIN_M)
+    return (
+        float(east.min() - margin),
+        float(north.min() - margin),
+        float(east.max() + margin),
+        float(north.max() + margin),
+    )
+
+
+def place_labels(
+    anchors_pt: np.ndarray, widths_pt: Sequence[float], obstacles_pt: np.ndarray
+) -> np.ndarray:
+    """Offsets (points) of labels centred near their anchors: for each label in turn, the
+    nearest candidate whose box overlaps no label placed before it and no plotted point
+    (``obstacles_pt``), so that a cluster of pairs gets numbers that can be read (joined
+    to their pairs by leader lines); the farthest candidate when none is free."""
+    height = LABEL_POINTS + 1.0
+    angles = np.deg2rad(np.arange(45.0, 405.0, 45.0))
+    candidates = [(r * np.cos(a), r * np.sin(a)) for r in LABEL_RADII_PT for a in angles]
+    placed = np.empty((0, 4))
+    offsets = np.zeros((len(anchors_pt), 2))
+    for i, ((x, y), width) in enumerate(zip(anchors_pt, widths_pt, strict=True)):
+        for dx, dy in candidates:
+            centre_x, centre_y = x + dx, y + dy
+            box = np.array(
+                [
+                    centre_x - width / 2,
+                    centre_y - height / 2,
+                    centre_x + width / 2,
+                    centre_y + height / 2,
+                ]
+            )
+            overlaps = (
+                (placed[:, 0] < box[2])
+                & (box[0] < placed[:, 2])
+                & (placed[:, 1] < box[3])
+                & (box[1] < placed[:, 3])
+            )
+            covers = (
+                (obstacles_pt[:, 0] > box[0] - 2)
+                & (obstacles_pt[:, 0] < box[2] + 2)
+                & (obstacles_pt[:, 1] > box[1] - 2)
+                & (obstacles_pt[:, 1] < box[3] + 2)
+            )
+            if not overlaps.any() and not covers.any():
+                break
+        placed = np.vstack([placed, box])
+        offsets[i] = (dx, dy)
+    return offsets
+
+
+def overview_figure(result: ReplayResult, chart: Chart | None) -> Figure:
+    """The triggered pairs (at least one) on one map, with latitude and longitude on the
+    axes and the chart under them when there is one (cut to the view): each pair's two
+    positions at the trigger, joined, coloured by situation, and numbered as in the table's
+    ``pair`` column (``place_labels``); each number links to ``#pair-N``."""
+    frame = result.frame
+    numbers = pair_numbers(result)
+    positions = [
+        frame.to_local(
+            np.array([p.summary.lat_deg_at_trigger_a, p.summary.lat_deg_at_trigger_b]),
+            np.array([p.summary.lon_deg_at_trigger_a, p.summary.lon_deg_at_trigger_b]),
+        )
+        for p in result.pairs
+    ]
+    north = np.concatenate([n for n, _ in positions])
+    east = np.concatenate([e for _, e in positions])
+    view = _map_view(east, north)
+    left, right, bottom, top = MAP_MARGINS_IN
+    map_height_in = MAP_HEIGHT_IN - bottom - top
+    view_width_m, view_height_m = view[2] - view[0], view[3] - view[1]
+    width_in = float(np.clip(map_height_in * view_width_m / view_height_m + left + right, 5, 12))
+    figure, ax = plt.subplots(figsize=(width_in, MAP_HEIGHT_IN))
+    figure.subplots_adjust(
+        left=left / width_in,
+        right=1 - right / width_in,
+        bottom=bottom / MAP_HEIGHT_IN,
+        top=1 - top / MAP_HEIGHT_IN,
+    )
+    if chart is not None:
+        draw_chart(ax, chart, None, view=view)
+    else:
+        show_view(ax, view)
+    # Points per metre on the map (an equal-aspect box fits the view in the margins).
+    scale = min((width_in - left - right) * 72 / view_width_m, map_height_in * 72 / view_height_m)
+    texts = [str(numbers[p.summary.pair_id]) for p in result.pairs]
+    anchors = np.array([(e[0], n[0]) for n, e in positions])
+    offsets = place_labels(
+        anchors * scale,
+        [0.62 * LABEL_POINTS * len(t) + 2 for t in texts],
+        np.column_stack([east, north]) * scale,
+    )
+    seen: set[str] = set()
+    for pair, (pair_north, pair_east), text, anchor, offset in zip(
+        result.pairs, positions, texts, anchors, offsets, strict=True
+    ):
+        situation = _text(pair.summary.situation)
+        ax.plot(
+            pair_east,
+            pair_north,
+            "o-",
+            color=SITUATION_COLOURS.get(situation, "0.3"),
+            markersize=4,
+            label=None if situation in seen else situation,
+        )
+        seen.add(situation)
+        label = ax.annotate(
+            text,
+            tuple(anchor),
+            xytext=tuple(offset),
+            textcoords="offset points",
+            fontsize=LABEL_POINTS,
+            ha="center",
+            va="center",
+            arrowprops={"arrowstyle": "-", "color": "0.3", "linewidth": 0.4, "shrinkB": 2},
+        )
+        label.set_url(f"#pair-{text}")
+        label.set_gid(f"pair-{text}")
+    geographic_axes(ax, frame)
+    if seen:
+        ax.legend(loc="best", fontsize="small")
+    ax.set_title(
+        f"{len(result.pairs)} triggered pairs at their trigger positions,\n"
+        "numbered as in the table's pair column",
+        fontsize="medium",
+    )
+    return figure
+
+
 def overview_svg(result: ReplayResult, chart: Chart | None) -> str:
-    """The encounters on one map (the run's frame, km from its centre; the chart under them
-    when there is one), as an inline SVG: each pair's two positions at the trigger, joined,
-    coloured by situation and numbered as in the table."""
-    figure, ax = plt.subplots(figsize=(8, 6.5))
+    """``overview_figure`` as an inline SVG."""
+    figure = overview_figure(result, chart)
     try:
-        if chart is not None:
-            draw_chart(ax, chart, None)
-        colours = {"crossing": "tab:blue", "head-on": "tab:red", "overtaking": "tab:green"}
-        frame = result.frame
-        seen: set[str] = set()
-        for number, pair in enumerate(result.pairs, start=1):
-            s = pair.summary
-            north, east = frame.to_local(
-                np.array([s.lat_deg_at_trigger_a, s.lat_deg_at_trigger_b]),
-                np.array([s.lon_deg_at_trigger_a, s.lon_deg_at_trigger_b]),
-            )
-            situation = _text(s.situation)
-            colour = colours.get(situation, "0.3")
-            ax.plot(
-                east,
-                north,
-                "o-",
-                color=colour,
-                markersize=4,
-                label=None if situation in seen else situation,
-            )
-            seen.add(situation)
-            ax.annotate(
-                str(number),
-                (east[0], north[0]),
-                fontsize=7,
-                xytext=(3, 3),
-                textcoords="offset points",
-            )
-        ax.set_aspect("equal")
-        ax.set_xlabel(f"east (m) of {frame.lat0_deg:.4f}° N, {frame.lon0_deg:.4f}° E")
-        ax.set_ylabel("north (m)")
-        if seen:
-            ax.legend(loc="best", fontsize="small")
-        ax.set_title(f"{len(result.pairs)} triggered pairs at their trigger positions")
         buffer = io.StringIO()
         # No date and fixed element ids: the same run gives the same page.
         with matplotlib.rc_context({"svg.hashsalt": "colregs9"}):
@@ -293,11 +438,23 @@ def overview_svg(result: ReplayResult, chart: Chart | None) -> str:
     finally:
         plt.close(figure)
     svg = buffer.getvalue()
-    return svg[svg.index("<svg") :]
+    # matplotlib opens every link in a new window; a pair's number filters this page's table.
+    return svg[svg.index("<svg") :].replace(' target="_blank"', "")
 
 
-def replay_html(result: ReplayResult, chart: Chart | None, plots: bool, encounter_dir: str) -> str:
-    """The replay's index.html (see the module docstring)."""
+def _file_links(files: Sequence[str]) -> str:
+    return ", ".join(f'<a href="{html.escape(f)}">{html.escape(f)}</a>' for f in files)
+
+
+def replay_html(
+    result: ReplayResult,
+    chart: Chart | None,
+    plots: bool,
+    encounter_dir: str,
+    files: Sequence[str],
+) -> str:
+    """The replay's index.html (see the module docstring); ``files`` are the report's other
+    files written beside it, linked from the top."""
     counts = result.counts
     title = f"Replay: {result.query_name}"
     body = [
@@ -305,14 +462,13 @@ def replay_html(result: ReplayResult, chart: Chart | None, plots: bool, encounte
         f"<p>{counts.vessels} vessels; {counts.encounters} encounters, {counts.triggered} "
         f"triggered (CPA &lt; {result.params.replay.cpa_req_m:g} m within 0 ≤ TCPA ≤ "
         f"{result.params.replay.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs. Files: "
-        '<a href="pairs.csv">pairs.csv</a>, <a href="encounters.csv">encounters.csv</a>, '
-        '<a href="report.gpkg">report.gpkg</a>, <a href="run.json">run.json</a>.</p>',
-        '<h2>Map</h2><div class="map">',
-        overview_svg(result, chart),
-        "</div>",
-        "<h2>Encounters</h2>",
+        f"{_file_links(files)}.</p>",
     ]
-    rows = [_encounter_row(outcome) for outcome in result.encounters]
+    if result.pairs:
+        body += ['<h2>Map</h2><div class="map">', overview_svg(result, chart), "</div>"]
+    body.append("<h2>Encounters</h2>")
+    numbers = pair_numbers(result)
+    rows = [_encounter_row(outcome, numbers) for outcome in result.encounters]
     links = [f"#enc-{outcome.summary.encounter_id}" for outcome in result.encounters]
     if rows:
         body += sortable_table("encounters", ENCOUNTER_TABLE_COLUMNS, rows, _SELECTS, links)
@@ -347,8 +503,7 @@ def stats_html(
 ) -> str:
     """The stats' index.html: each table (sortable), each histogram (a PNG beside it), and
     links to the other ``files``."""
-    links = ", ".join(f'<a href="{html.escape(f)}">{html.escape(f)}</a>' for f in files)
-    body = [f"<h1>{html.escape(title)}</h1>", f"<p>Files: {links}.</p>"]
+    body = [f"<h1>{html.escape(title)}</h1>", f"<p>Files: {_file_links(files)}.</p>"]
     for number, (heading, frame) in enumerate(tables):
         body.append(f"<h2>{html.escape(heading)}</h2>")
         rows = [list(row) for row in frame.itertuples(index=False)]

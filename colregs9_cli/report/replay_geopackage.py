@@ -3,7 +3,10 @@
 Layers (each only when it has features):
 
 - ``encounters``: a point at each vessel's position at the trigger, one per vessel and
-  encounter row, with every ``encounters.csv`` column and ``vessel`` (own or target);
+  encounter row, with every ``encounters.csv`` column and ``vessel`` (own or target).
+  ``action_before_cpa_s`` is the point's vessel's: how long before CPA she acted, empty when
+  she is not a give-way vessel or did not act (encounters.csv lists the give-way vessels'
+  values, ``;``-separated);
 - ``tracks``: each vessel's track over the encounter, a line per vessel and encounter;
 - ``cpa``: each vessel's position predicted at TCPA from the trigger;
 - ``domains``: the target's ship-domain ellipses at the trigger, with ``restricted`` and
@@ -11,11 +14,19 @@ Layers (each only when it has features):
 - ``navigable_water``: the water deep enough for each target draught used, where a chart was
   given.
 
-Each layer carries a default QGIS style in the ``layer_styles`` table (``qgis_styles.py``).
+Fields are typed as their values: MMSIs, steps and navigational statuses as integers (empty
+when none), two-valued flags as booleans, measurements as reals, times as UTC date-times;
+three-valued facts (``true``, ``false``, ``insufficient-data`` or ``unknown``) and the other
+codes stay text. Each layer carries a default QGIS style in the ``layer_styles`` table
+(``qgis_styles.py``).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import types
+import typing
+from enum import Enum
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +37,7 @@ import shapely
 
 from ..chart import Chart
 from ..geo import LocalFrame
-from ..replay_results import ReplayResult
+from ..replay_results import EncounterOutcome, EncounterSummary, ReplayResult
 from .atomic import atomic_path
 from .qgis_styles import add_layer_styles
 
@@ -44,51 +55,111 @@ def _to_wgs84(frame: LocalFrame, geometries: Any) -> np.ndarray:
     )
 
 
-def _fields(table: pd.DataFrame) -> tuple[list[np.ndarray], list[str]]:
-    """Columns as GDAL fields: booleans as booleans, numbers as float, everything else as
-    text."""
-    values: list[np.ndarray] = []
-    names: list[str] = []
+# GDAL's time-zone flag for UTC (1 is local time, 100 + n is n quarter-hours east of UTC).
+GDAL_UTC = 100
+
+
+@dataclasses.dataclass
+class _Fields:
+    """A layer's attribute columns as ``pyogrio.raw.write`` takes them."""
+
+    values: list[np.ndarray]
+    names: list[str]
+    masks: list[np.ndarray | None]
+    tz_offsets: dict[str, np.ndarray]
+
+
+def _fields(table: pd.DataFrame) -> _Fields:
+    """Columns as GDAL fields by their dtype: integers (nullable) as integers, booleans as
+    booleans, floats as reals, UTC times as date-times, everything else as text."""
+    fields = _Fields([], [], [], {})
     for name in table.columns:
         column = table[name]
-        numeric = pd.api.types.is_numeric_dtype(column) and not pd.api.types.is_bool_dtype(column)
-        if pd.api.types.is_bool_dtype(column) and not column.isna().any():
-            values.append(column.to_numpy(dtype=bool))
-        elif numeric:
-            values.append(column.to_numpy(dtype=float, na_value=np.nan))
+        missing = column.isna().to_numpy()
+        mask = missing if missing.any() else None
+        if pd.api.types.is_bool_dtype(column):
+            values = column.to_numpy(dtype=bool, na_value=False)
+        elif pd.api.types.is_integer_dtype(column):
+            values = column.to_numpy(dtype=np.int64, na_value=0)
+        elif pd.api.types.is_float_dtype(column):
+            values, mask = column.to_numpy(dtype=float, na_value=np.nan), None
+        elif isinstance(column.dtype, pd.DatetimeTZDtype):
+            values = column.dt.tz_convert("UTC").dt.tz_localize(None).to_numpy("datetime64[ms]")
+            fields.tz_offsets[str(name)] = np.full(len(column), GDAL_UTC)
+            mask = None  # NaT is written as null
         else:
-            values.append(
-                np.asarray([None if pd.isna(v) else str(v) for v in column], dtype=object)
-            )
-        names.append(str(name))
-    return values, names
+            values = np.asarray([None if pd.isna(v) else str(v) for v in column], dtype=object)
+            mask = None
+        fields.values.append(values)
+        fields.names.append(str(name))
+        fields.masks.append(mask)
+    return fields
 
 
-def write_replay_geopackage(
-    path: Path, result: ReplayResult, encounters: pd.DataFrame, chart: Chart | None
-) -> Path | None:
-    """Write ``report.gpkg`` (see the module docstring); ``encounters`` is encounters.csv as
-    written. Returns None when there is nothing to map."""
+def _dtype(annotation: Any) -> str:
+    """The pandas dtype of an ``EncounterSummary`` field (``X | None`` as X, nullable)."""
+    if isinstance(annotation, types.UnionType):
+        annotation = next(a for a in typing.get_args(annotation) if a is not type(None))
+    if annotation is bool:
+        return "bool"
+    if annotation is int:
+        return "Int64"
+    if annotation is float:
+        return "float64"
+    if annotation is pd.Timestamp:
+        return "datetime64[ns, UTC]"
+    return "object"
+
+
+def _encounter_table(outcomes: tuple[EncounterOutcome, ...]) -> pd.DataFrame:
+    """encounters.csv's rows with their values' types (enums as their text)."""
+    records = [
+        {
+            name: value.value if isinstance(value, Enum) else value
+            for name, value in dataclasses.asdict(outcome.summary).items()
+        }
+        for outcome in outcomes
+    ]
+    hints = typing.get_type_hints(EncounterSummary)
+    table = pd.DataFrame.from_records(records, columns=list(hints))
+    return table.astype({name: _dtype(hint) for name, hint in hints.items()})
+
+
+def _action_before_cpa_s(summary: EncounterSummary, mmsi: int) -> float:
+    """How long before CPA the vessel ``mmsi`` acted, NaN when she is not a give-way vessel
+    or did not act (``give_way_vessels`` and ``action_before_cpa_s`` list the give-way
+    vessels in the same order)."""
+    give_way = summary.give_way_vessels.split(";")
+    seconds = summary.action_before_cpa_s.split(";")
+    if str(mmsi) not in give_way:
+        return float("nan")
+    value = seconds[give_way.index(str(mmsi))]
+    return float(value) if value else float("nan")
+
+
+def write_replay_geopackage(path: Path, result: ReplayResult, chart: Chart | None) -> Path | None:
+    """Write ``report.gpkg`` (see the module docstring). Returns None when there is nothing
+    to map."""
     outcomes = result.encounters
     if not outcomes:
         return None
     frame = result.frame
     layers: dict[str, tuple[np.ndarray, pd.DataFrame]] = {}
-    rows = encounters.reset_index(drop=True)
     points: list[Any] = []
     tracks: list[Any] = []
     cpa: list[Any] = []
-    point_rows: list[dict[str, Any]] = []
+    actions: list[float] = []
     track_rows: list[dict[str, Any]] = []
     cpa_rows: list[dict[str, Any]] = []
-    for index, outcome in enumerate(outcomes):
+    for outcome in outcomes:
         trigger = outcome.series.iloc[0]
         for vessel, track, at_tcpa in (
             ("own", outcome.own_track, outcome.own_at_tcpa_m),
             ("target", outcome.target_track, outcome.target_at_tcpa_m),
         ):
+            mmsi = getattr(outcome.summary, f"{vessel}_mmsi")
             points.append(shapely.Point(trigger[f"{vessel}_east_m"], trigger[f"{vessel}_north_m"]))
-            point_rows.append({**rows.iloc[index].to_dict(), "vessel": vessel})
+            actions.append(_action_before_cpa_s(outcome.summary, mmsi))
             line = track.dropna()
             if len(line) >= 2:
                 tracks.append(shapely.LineString(line[["east_m", "north_m"]].to_numpy()))
@@ -96,7 +167,7 @@ def write_replay_geopackage(
                     {
                         "encounter_id": outcome.summary.encounter_id,
                         "vessel": vessel,
-                        "mmsi": getattr(outcome.summary, f"{vessel}_mmsi"),
+                        "mmsi": mmsi,
                     }
                 )
             cpa.append(shapely.Point(at_tcpa[1], at_tcpa[0]))
@@ -104,11 +175,17 @@ def write_replay_geopackage(
                 {
                     "encounter_id": outcome.summary.encounter_id,
                     "vessel": vessel,
-                    "mmsi": getattr(outcome.summary, f"{vessel}_mmsi"),
+                    "mmsi": mmsi,
                     "tcpa_s": outcome.summary.tcpa_s,
                 }
             )
-    layers["encounters"] = (_to_wgs84(frame, points), pd.DataFrame(point_rows))
+    # Each encounter row twice, own ship's point then the target's.
+    table = _encounter_table(outcomes)
+    point_rows = table.loc[table.index.repeat(2)].reset_index(drop=True)
+    point_rows = point_rows.assign(
+        action_before_cpa_s=actions, vessel=["own", "target"] * len(outcomes)
+    )
+    layers["encounters"] = (_to_wgs84(frame, points), point_rows)
     layers["tracks"] = (_to_wgs84(frame, tracks), pd.DataFrame(track_rows))
     layers["cpa"] = (_to_wgs84(frame, cpa), pd.DataFrame(cpa_rows))
     domains: list[Any] = []
@@ -149,12 +226,14 @@ def write_replay_geopackage(
         for layer, (wkb, table) in layers.items():
             if len(wkb) == 0:
                 continue
-            values, names = _fields(table)
+            fields = _fields(table)
             pyogrio.raw.write(
                 tmp,
                 wkb,
-                values,
-                names,
+                fields.values,
+                fields.names,
+                field_mask=fields.masks,
+                gdal_tz_offsets=fields.tz_offsets,
                 layer=layer,
                 driver="GPKG",
                 geometry_type=_geometry_type(layer),

@@ -33,7 +33,16 @@ from ..replay_results import (
     ReplayResult,
 )
 from .atomic import report_directory, save_figure, write_csv, write_json, write_text
-from .chart_plot import DEPTH_LABEL, ELLIPSE_ZORDER, draw_assessment, draw_chart, geographic_axes
+from .chart_plot import (
+    DEPTH_LABEL,
+    NOT_CHARTED_LABEL,
+    TRACK_ZORDER,
+    Bounds,
+    draw_assessment,
+    draw_chart,
+    geographic_axes,
+    show_view,
+)
 from .html_report import HTML_NAME, replay_html
 from .replay_geopackage import GEOPACKAGE_NAME, write_replay_geopackage
 
@@ -53,13 +62,16 @@ MANIFEST_NAME = "run.json"
 OWN_DOT_COLOUR = "tab:red"
 OWN_TRACK_COLOUR = "darkorange"
 TARGET_COLOUR = "black"
-# Tracks under the ellipses; markers above everything.
-TRACK_ZORDER = ELLIPSE_ZORDER - 0.5
+# Markers above everything (the tracks are above the ellipses: chart_plot's order).
 MARKER_ZORDER = 6.0
 # Direction-of-travel arrows at these fractions of each track's length.
 ARROW_FRACTIONS = (0.2, 0.5, 0.8)
 # The smallest view: half a side of 200 m, so that a short encounter still shows its setting.
 ZOOM_MIN_HALF_WIDTH_M = 200.0
+# At most this many clear (or grey) ellipse outlines per arc, so that they stay apart.
+OUTLINES_PER_ARC = 24
+# Under the legend when a vessel's label has a dimension marked with ``*``.
+DEFAULTED_NOTE = "* dimension not in AIS: a default was used"
 
 
 def _cell(value: Any) -> Any:
@@ -179,8 +191,8 @@ def _verdict(outcome: EncounterOutcome) -> str:
     )
 
 
-def _zoom_to_encounter(ax: Any, outcome: EncounterOutcome) -> None:
-    """Show the tracks, the positions at TCPA and the arcs, not the whole chart."""
+def _view_box(outcome: EncounterOutcome) -> Bounds:
+    """A square around the tracks, the positions at TCPA and the arcs, not the whole chart."""
     east = np.concatenate(
         [
             outcome.own_track["east_m"].to_numpy(),
@@ -201,9 +213,12 @@ def _zoom_to_encounter(ax: Any, outcome: EncounterOutcome) -> None:
     centre_north = (np.nanmin(north) + np.nanmax(north)) / 2.0
     half = max(np.nanmax(east) - np.nanmin(east), np.nanmax(north) - np.nanmin(north)) * 0.6
     half = max(half, ZOOM_MIN_HALF_WIDTH_M)
-    ax.set_aspect("equal", adjustable="box")
-    ax.set_xlim(centre_east - half, centre_east + half)
-    ax.set_ylim(centre_north - half, centre_north + half)
+    return (
+        float(centre_east - half),
+        float(centre_north - half),
+        float(centre_east + half),
+        float(centre_north + half),
+    )
 
 
 def trigger_positions_m(outcome: EncounterOutcome) -> tuple[tuple[float, float], ...]:
@@ -325,16 +340,22 @@ def _draw_positions(
 
 def _legend_below(figure: Figure, ax: Any) -> None:
     """A compact legend under the axes, so that it covers nothing: own ship, then the arcs
-    and the water, in one column; the target, then the ellipses, in the other."""
+    and the chart, in one column; the target, then the ellipses, in the other, and what
+    ``*`` means when a vessel's label has one."""
     handles, labels = ax.get_legend_handles_labels()
     entries = list(zip(handles, labels, strict=True))
     own = [e for e in entries if e[1].startswith("own ship")]
     target = [e for e in entries if e[1].startswith("target")]
-    arcs_and_water = [e for e in entries if e[1].endswith("arc") or e[1].startswith("navigable")]
-    ellipses = [e for e in entries if e[1].endswith("ellipses")]
-    columns = [own + arcs_and_water, target + ellipses]
-    rows = max(len(c) for c in columns)
+    chart = [
+        e
+        for e in entries
+        if e[1].endswith("arc") or e[1].startswith("navigable") or e[1] == NOT_CHARTED_LABEL
+    ]
+    ellipses = [e for e in entries if " ellipses" in e[1]]
     blank = (Line2D([], [], linestyle="none"), "")
+    defaulted = any("*" in label for _, label in own + target)
+    columns = [own + chart, target + ellipses + ([(blank[0], DEFAULTED_NOTE)] if defaulted else [])]
+    rows = max(len(c) for c in columns)
     # matplotlib fills a legend column by column: pad each to the same height.
     padded = [entry for c in columns for entry in c + [blank] * (rows - len(c))]
     figure.legend(
@@ -348,22 +369,24 @@ def _legend_below(figure: Figure, ax: Any) -> None:
 
 
 def _vessel_label(role: str, name: str | None, mmsi: int, dims: tuple[Any, ...]) -> str:
-    """``own ship NAME (MMSI), 50 × 9 m, T 3.2 m`` with ``*`` on dimensions defaulted."""
+    """``own ship NAME (MMSI), 50 × 9 m, T 3.2* m`` with ``*`` on the dimensions defaulted
+    (``dims`` ends with ``VesselDimensions.defaulted_text``, e.g. ``breadth;draught``)."""
     length_m, breadth_m, draught_m, defaulted = dims
     marked = set(str(defaulted or "").split(";"))
 
-    def value(name: str, metres: float) -> str:
-        return f"{metres:.3g}{'*' if name in marked else ''}"
+    def value(dimension: str, metres: float) -> str:
+        return f"{metres:.3g}{'*' if dimension in marked else ''}"
 
     who = f"{name} ({mmsi})" if name else str(mmsi)
     return (
-        f"{role} {who}, {value('length_m', length_m)} × {value('breadth_m', breadth_m)} m, "
-        f"T {value('draught_m', draught_m)} m"
+        f"{role} {who}, {value('length', length_m)} × {value('breadth', breadth_m)} m, "
+        f"T {value('draught', draught_m)} m"
     )
 
 
-def _mark_data_end(ax: Any, track: pd.DataFrame, colour: str, role: str) -> None:
-    """An × where a track's data stops before the closest approach."""
+def _mark_data_end(ax: Any, track: pd.DataFrame, colour: str, role: str, early: bool) -> None:
+    """An × at a track's last position: where the data stops before the closest approach
+    (``early``), else where the figure's series ends."""
     east = track["east_m"].to_numpy(dtype=float)
     north = track["north_m"].to_numpy(dtype=float)
     known = np.isfinite(east) & np.isfinite(north)
@@ -377,7 +400,7 @@ def _mark_data_end(ax: Any, track: pd.DataFrame, colour: str, role: str) -> None
             markersize=10,
             markeredgewidth=2.0,
             zorder=MARKER_ZORDER,
-            label=f"{role} data ends (before CPA)",
+            label=f"{role} data ends (before CPA)" if early else f"{role} end of track",
             gid=f"{role.replace(' ', '-')}-data-end",
         )
 
@@ -389,20 +412,24 @@ def encounter_figure(
     and longitude on the axes and a scale bar (``chart_plot.geographic_axes``).
 
     The chart background (depth areas with a DRVAL1 colour bar, land, navigable water for the
-    target's draught) when a chart covers the run; both tracks over the encounter with arrows
-    for the direction of travel (own ship dark orange, target black dashed); both vessels at
-    the trigger (hollow squares) and predicted at TCPA from the trigger (own ship red dot,
-    target black dot); an × where a track's data stops before CPA; and the target's projected
-    arcs with red (restricted) and blue (clear) ellipses at the trigger, half transparent so
-    that the tracks show through. The legend under the axes names both vessels with their
-    dimensions (``*``: a default, not reported); the title gives the times of the trigger and
-    of the predicted CPA.
+    target's draught, and hatched grey where the chart does not reach) when a chart covers
+    the run, cut to the view; both tracks over the encounter with arrows for the direction of
+    travel (own ship dark orange, target black dashed) and an × at each one's end; both
+    vessels at the trigger (hollow squares) and predicted at TCPA from the trigger (own ship
+    red dot, target black dot); and the target's projected arcs with red (restricted) and blue
+    (clear) ellipses at the trigger, light and under the tracks, every red one and at most
+    ``OUTLINES_PER_ARC`` others per arc. The legend under the axes names both vessels with
+    their dimensions (``*``: a default, not reported); the title gives the times of the
+    trigger and of the predicted CPA.
     """
     s = outcome.summary
     figure, ax = plt.subplots(figsize=(8.5, 9.2), layout="constrained")
+    view = _view_box(outcome)
     if chart is not None:
-        depths = draw_chart(ax, chart, s.target_draught_m, ukc_m)
+        depths = draw_chart(ax, chart, s.target_draught_m, ukc_m, view=view)
         figure.colorbar(depths, ax=ax, label=DEPTH_LABEL, shrink=0.6, pad=0.02)
+    else:
+        show_view(ax, view)
     own_label = _vessel_label(
         "own ship",
         s.own_name,
@@ -417,10 +444,11 @@ def encounter_figure(
     )
     _draw_track(ax, outcome.own_track, OWN_TRACK_COLOUR, "-", own_label, "own-direction")
     _draw_track(ax, outcome.target_track, TARGET_COLOUR, "--", target_label, "target-direction")
-    if not s.data_covers_cpa:
-        _mark_data_end(ax, outcome.own_track, OWN_TRACK_COLOUR, "own ship")
-        _mark_data_end(ax, outcome.target_track, TARGET_COLOUR, "target")
-    draw_assessment(ax, outcome.assessment)
+    early = not s.data_covers_cpa
+    _mark_data_end(ax, outcome.own_track, OWN_TRACK_COLOUR, "own ship", early)
+    _mark_data_end(ax, outcome.target_track, TARGET_COLOUR, "target", early)
+    steps_per_arc = int(outcome.assessment.step.max(initial=1))
+    draw_assessment(ax, outcome.assessment, every=math.ceil(steps_per_arc / OUTLINES_PER_ARC))
     own_at_trigger_m, target_at_trigger_m = trigger_positions_m(outcome)
     _draw_positions(
         ax, "own ship", own_at_trigger_m, outcome.own_at_tcpa_m, OWN_DOT_COLOUR, OWN_TRACK_COLOUR
@@ -428,7 +456,6 @@ def encounter_figure(
     _draw_positions(
         ax, "target", target_at_trigger_m, outcome.target_at_tcpa_m, TARGET_COLOUR, TARGET_COLOUR
     )
-    _zoom_to_encounter(ax, outcome)
     geographic_axes(ax, frame)
     _legend_below(figure, ax)
     at_cpa = s.trigger_utc + pd.Timedelta(seconds=s.tcpa_s)
@@ -556,17 +583,20 @@ def _write_replay_files(
     if figures:
         drawer(figures, chart, result.params.manoeuvrability.ukc_m, result.frame, progress)
     encounters_csv = out_dir / ENCOUNTERS_NAME
-    encounters_table = _lowercase_booleans(encounters_frame(result.encounters))
-    write_csv(encounters_csv, encounters_table)
-    geopackage = write_replay_geopackage(out_dir / GEOPACKAGE_NAME, result, encounters_table, chart)
+    write_csv(encounters_csv, _lowercase_booleans(encounters_frame(result.encounters)))
+    geopackage = write_replay_geopackage(out_dir / GEOPACKAGE_NAME, result, chart)
     if geopackage is not None:
         files.append(geopackage)
     pairs_csv = out_dir / PAIRS_NAME
     write_csv(pairs_csv, _lowercase_booleans(pairs_frame(result.pairs)))
     index = out_dir / INDEX_NAME
     write_text(index, format_index(result, plots))
-    page = out_dir / HTML_NAME
-    write_text(page, replay_html(result, chart, plots, ENCOUNTER_DIR))
     manifest = out_dir / MANIFEST_NAME
     write_json(manifest, result.manifest)
+    # The page links only the files written (no report.gpkg without encounters).
+    linked = [pairs_csv, encounters_csv, *([geopackage] if geopackage else []), index, manifest]
+    page = out_dir / HTML_NAME
+    write_text(
+        page, replay_html(result, chart, plots, ENCOUNTER_DIR, [path.name for path in linked])
+    )
     return (pairs_csv, encounters_csv, *files, index, page, manifest)

@@ -12,7 +12,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib import colormaps
+from matplotlib.colors import to_hex
 from matplotlib.figure import Figure
+from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from .atomic import report_directory, save_figure, write_csv, write_json, write_text
@@ -36,7 +38,7 @@ DIMENSION_LABELS: dict[str, str] = {
 }
 HISTOGRAM_MAX_BINS = 40
 # Ship types stacked in the histograms: 40 colours before one repeats (DMA has 27 types).
-TYPE_COLOURS = [tuple(c) for name in ("tab20", "tab20b") for c in colormaps[name](np.arange(20))]
+TYPE_COLOURS = [to_hex(c) for name in ("tab20", "tab20b") for c in colormaps[name](np.arange(20))]
 
 
 def _number(value: float, decimals: int) -> str:
@@ -123,14 +125,26 @@ def format_markdown(result: StatsResult, query_name: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+def type_colours(result: StatsResult) -> dict[str, str]:
+    """One colour per ship type of the grouped statistics (the CSV's groups), the same in
+    every panel whatever types a dimension has values for."""
+    return {
+        str(table.group): TYPE_COLOURS[i % len(TYPE_COLOURS)]
+        for i, table in enumerate(result.groups)
+    }
+
+
 def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     """Three histograms (length, breadth, draught) of the counted units' values, stacked by
-    ship type when the statistics are grouped by it."""
+    ship type when the statistics are grouped by it: each type in its colour in every panel
+    (``type_colours``), each stack (a ``BarContainer``) labelled with its type, and one legend
+    for all the types."""
     # A bare Figure renders with Agg on save, without pyplot's backend machinery. Fixed
     # margins: a layout engine would double the time of drawing these three panels.
     figure = Figure(figsize=(13, 4))
     figure.subplots_adjust(left=0.05, right=0.99, bottom=0.13, top=0.82, wspace=0.22)
     axes = figure.subplots(1, 3)
+    colours = type_colours(result)
     for axis, (dimension, label) in zip(axes, DIMENSION_LABELS.items(), strict=True):
         samples = result.samples[["ship_type", dimension]].dropna(subset=[dimension])
         values = samples[dimension].to_numpy(dtype=float)
@@ -141,16 +155,21 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
                 axis.hist(values, bins=edges, color="tab:blue", edgecolor="white")
             else:
                 # Stacked by ship type: the bars' heights are the overall histogram's.
-                groups = sorted(samples.groupby(samples["ship_type"].fillna("Unknown")))
+                types = samples["ship_type"].astype(str)
+                groups = [
+                    (name, values[types == name]) for name in colours if (types == name).any()
+                ]
                 axis.hist(
-                    [group[dimension].to_numpy(dtype=float) for _, group in groups],
+                    [group for _, group in groups],
                     bins=edges,
                     stacked=True,
-                    color=[TYPE_COLOURS[i % len(TYPE_COLOURS)] for i in range(len(groups))],
-                    label=[str(name) for name, _ in groups],
+                    color=[colours[name] for name, _ in groups],
                     edgecolor="white",
                     linewidth=0.3,
                 )
+                # One bar container per type, in the order given.
+                for stack, (name, _) in zip(axis.containers, groups, strict=True):
+                    stack.set_label(name)
         else:
             axis.text(0.5, 0.5, "no values", ha="center", va="center", transform=axis.transAxes)
         # Few ticks: each costs about a millisecond to make and draw.
@@ -161,9 +180,14 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
         # A set height spares matplotlib its search for tick labels above the axes.
         axis.set_title(f"{label}: n = {values.size}", y=1.0)
     figure.suptitle(_title(result, query_name))
-    if result.by is not None and axes[0].get_legend_handles_labels()[0]:
+    if colours:
         figure.subplots_adjust(right=0.86)
-        figure.legend(*axes[0].get_legend_handles_labels(), loc="center right", fontsize="x-small")
+        figure.legend(
+            [Patch(facecolor=colour) for colour in colours.values()],
+            list(colours),
+            loc="center right",
+            fontsize="x-small",
+        )
     return figure
 
 
