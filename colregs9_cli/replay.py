@@ -512,6 +512,7 @@ def evaluate_pair(
                 flip,
                 encounter,
                 params,
+                tracks.frame,
             )
         )
     return PairOutcome(summary=pair_summary, seats=tuple(outcomes))
@@ -681,6 +682,7 @@ def _seat_outcome(
     flip: bool,
     encounter: Encounter,
     params: ReplayRunParams,
+    run_frame: LocalFrame,
 ) -> EncounterOutcome:
     """The encounters.csv row, series and figure data of one seat of a pair."""
     own_index, target_index = (1, 0) if flip else (0, 1)
@@ -757,27 +759,52 @@ def _seat_outcome(
         target_dimensions_defaulted=target.dimensions.defaulted_text,
     )
     tcpa_s = pair.tcpa_s
+    metre_columns = [f"{p}{c}" for p in ("own_", "target_") for c in ("north_m", "east_m")]
+    in_run_frame = bool(np.isfinite(full[metre_columns].to_numpy(dtype=float)).all())
+    # A pair beyond the run frame's reach is drawn and mapped in a frame of its own.
+    frame = (
+        run_frame
+        if in_run_frame
+        else LocalFrame(float(trigger["own_lat_deg"]), float(trigger["own_lon_deg"]))
+    )
 
-    def at_tcpa(prefix: str) -> tuple[float, float]:
-        v_north, v_east = velocity_mps(
-            trigger[f"{prefix}speed_mps"], trigger[f"{prefix}cog_grid_deg"]
-        )
-        return (
-            float(trigger[f"{prefix}north_m"] + v_north * tcpa_s),
-            float(trigger[f"{prefix}east_m"] + v_east * tcpa_s),
-        )
+    def at_trigger(prefix: str) -> tuple[float, float]:
+        if in_run_frame:
+            return float(trigger[f"{prefix}north_m"]), float(trigger[f"{prefix}east_m"])
+        north, east = frame.to_local(trigger[f"{prefix}lat_deg"], trigger[f"{prefix}lon_deg"])
+        return float(north), float(east)
+
+    def at_tcpa(vessel: VesselAtTrigger, prefix: str) -> tuple[float, float]:
+        if in_run_frame:
+            v_north, v_east = velocity_mps(
+                trigger[f"{prefix}speed_mps"], trigger[f"{prefix}cog_grid_deg"]
+            )
+            return (
+                float(trigger[f"{prefix}north_m"] + v_north * tcpa_s),
+                float(trigger[f"{prefix}east_m"] + v_east * tcpa_s),
+            )
+        north, east = frame.to_local(vessel.lat_deg_at_cpa, vessel.lon_deg_at_cpa)
+        return float(north), float(east)
 
     def track(prefix: str) -> pd.DataFrame:
-        return full[[f"{prefix}north_m", f"{prefix}east_m"]].set_axis(["north_m", "east_m"], axis=1)
+        if in_run_frame:
+            metres = full[[f"{prefix}north_m", f"{prefix}east_m"]]
+            return metres.set_axis(["north_m", "east_m"], axis=1)
+        north, east = frame.to_local(full[f"{prefix}lat_deg"], full[f"{prefix}lon_deg"])
+        return pd.DataFrame({"north_m": north, "east_m": east}, index=full.index)
 
     return EncounterOutcome(
         summary=summary,
         series=_seat_series(steps, flip, params.replay.restricted_nav_statuses),
         own_track=track(own_prefix),
         target_track=track(target_prefix),
-        own_at_tcpa_m=at_tcpa(own_prefix),
-        target_at_tcpa_m=at_tcpa(target_prefix),
+        own_at_trigger_m=at_trigger(own_prefix),
+        target_at_trigger_m=at_trigger(target_prefix),
+        own_at_tcpa_m=at_tcpa(own, own_prefix),
+        target_at_tcpa_m=at_tcpa(target, target_prefix),
         assessment=steps.trigger_assessments[target_index],
+        frame=frame,
+        in_run_frame=in_run_frame,
     )
 
 

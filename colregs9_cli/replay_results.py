@@ -235,17 +235,24 @@ class EncounterOutcome:
     """One seat of a triggered pair: its row, time series and what its figure shows.
 
     ``own_track``/``target_track`` (``north_m``, ``east_m``) cover the encounter and the
-    audit window after it; ``*_at_tcpa_m`` are (north, east) predicted at constant velocity
-    from the trigger to TCPA; ``assessment`` is the target's manoeuvrability at the trigger.
+    audit window after it; ``*_at_trigger_m`` are (north, east) at the trigger and
+    ``*_at_tcpa_m`` predicted at constant velocity from the trigger to TCPA; ``assessment`` is
+    the target's manoeuvrability at the trigger. These metres are in ``frame``: the run's
+    frame, or, for a pair beyond its reach (``geo.FRAME_REACH_M``), a frame centred on the
+    pair, where no chart and no arcs are drawn.
     """
 
     summary: EncounterSummary
     series: pd.DataFrame
     own_track: pd.DataFrame
     target_track: pd.DataFrame
+    own_at_trigger_m: tuple[float, float]
+    target_at_trigger_m: tuple[float, float]
     own_at_tcpa_m: tuple[float, float]
     target_at_tcpa_m: tuple[float, float]
     assessment: ManoeuvrabilityAssessment
+    frame: LocalFrame
+    in_run_frame: bool
 
 
 @dataclass(frozen=True)

@@ -11,11 +11,14 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import pyogrio
 import pytest
+import shapely
 from pyproj import Geod
 
 from colregs9_cli.encounters import find_encounters
 from colregs9_cli.geo import LocalFrame
+from colregs9_cli.replay import run_replay
 from colregs9_cli.replay_params import ReplayParams
 from colregs9_cli.tracks import build_tracks
 
@@ -97,3 +100,69 @@ def test_range_and_cpa_agree_with_geod(lat: float, lon: float, frame: LocalFrame
     assert encounter.range_m_at_trigger == pytest.approx(range_m, abs=1.0 + 0.002 * range_m)
     assert encounter.cpa_m_at_trigger == pytest.approx(cpa_m, abs=1.0 + 0.002 * cpa_m)
     assert 40.0 < cpa_m < 80.0  # the geometry is what it was built to be
+
+
+def _marinecadastre_rows(mmsi: int, start: tuple[float, float, float]) -> pd.DataFrame:
+    seconds = np.arange(0.0, 1201.0, 2.0)
+    lat, lon, course = _at(*start, seconds)
+    return pd.DataFrame(
+        {
+            "MMSI": mmsi,
+            "BaseDateTime": (T0 + pd.to_timedelta(seconds, unit="s")).strftime("%Y-%m-%dT%H:%M:%S"),
+            "LAT": lat.round(7),
+            "LON": lon.round(7),
+            "SOG": round(SPEED_MPS * 3600.0 / 1852.0, 1),
+            "COG": course.round(1),
+            "Heading": 511,
+            "VesselName": f"V{mmsi}",
+            "IMO": "",
+            "CallSign": "",
+            "VesselType": 70,
+            "Status": 0,
+            "Length": 100,
+            "Width": 20,
+            "Draft": 5,
+            "Cargo": 70,
+            "TransceiverClass": "A",
+        }
+    )
+
+
+def test_a_replay_over_the_whole_earth_keeps_every_pair(tmp_path) -> None:
+    # A satellite feed's pairs: one on the equator across the antimeridian, one off Denmark.
+    # The run's frame, centred on the data (28.5° N, 95° E), reaches neither: each pair keeps
+    # its exact geometry, is estimated "unknown", and is drawn and mapped in a frame of its
+    # own (before, PROJ's inf positions lost the far pair or stopped the run).
+    places = {(366000001, 366000002): (0.0, 179.999), (366000003, 366000004): (57.0, 10.0)}
+    rows = []
+    for (own, target), (lat, lon) in places.items():
+        own_start, target_start = crossing_at(lat, lon)
+        rows += [_marinecadastre_rows(own, own_start), _marinecadastre_rows(target, target_start)]
+    path = tmp_path / "world.csv"
+    pd.concat(rows).to_csv(path, index=False)
+    result = run_replay([path], out_dir=tmp_path / "report", quiet=True)
+    assert {(p.summary.mmsi_a, p.summary.mmsi_b) for p in result.pairs} == set(places)
+    for pair in result.pairs:
+        lat, lon = places[(pair.summary.mmsi_a, pair.summary.mmsi_b)]
+        for seat in pair.seats:
+            assert not seat.in_run_frame
+            assert seat.frame.within_reach(lat, lon)
+            assert seat.summary.target_estimated_restricted == "unknown"
+            assert (result.out_dir / "encounters" / f"{seat.summary.encounter_id}.png").is_file()
+            own_start, target_start = crossing_at(lat, lon)
+            if seat.summary.own_mmsi != pair.summary.mmsi_a:
+                own_start, target_start = target_start, own_start
+            trigger_s = (seat.summary.trigger_utc - T0).total_seconds()
+            range_m, cpa_m = _geodesic_truth(own_start, target_start, trigger_s)
+            assert seat.summary.range_m_at_trigger == pytest.approx(range_m, abs=1.0, rel=2e-3)
+            assert seat.summary.cpa_m == pytest.approx(cpa_m, abs=1.0, rel=2e-3)
+    # The report's points lie where the vessels were, on either side of 180°.
+    _, _, wkb, fields = pyogrio.raw.read(result.out_dir / "report.gpkg", layer="encounters")
+    points = shapely.from_wkb(wkb)
+    names = list(pyogrio.read_info(result.out_dir / "report.gpkg", layer="encounters")["fields"])
+    own_mmsi = fields[names.index("own_mmsi")]
+    for point, mmsi in zip(points[::2], own_mmsi[::2], strict=True):
+        key = next(k for k in places if int(mmsi) in k)
+        lat, lon = places[key]
+        _, _, apart = GEOD.inv(lon, lat, point.x, point.y)
+        assert apart < 3_000.0

@@ -286,6 +286,7 @@ def _facts(outcome: EncounterOutcome) -> list[str]:
 # a few hundred metres, so that the setting of a lone pair shows.
 MAP_MARGIN_SHARE = 0.1
 MAP_MIN_MARGIN_M = 500.0
+MAP_MIN_MARGIN_DEG = 0.01
 SITUATION_COLOURS = {"crossing": "tab:blue", "head-on": "tab:red", "overtaking": "tab:green"}
 # The map is 8 in high and as wide as its view needs (5 to 12 in), with these margins
 # (inches: left for the latitudes, right, bottom for the longitudes, top for the title),
@@ -297,8 +298,8 @@ LABEL_POINTS = 7.0
 LABEL_RADII_PT = (7.0, 14.0, 22.0, 32.0, 44.0, 58.0)
 
 
-def _map_view(east: np.ndarray, north: np.ndarray) -> Bounds:
-    margin = max(MAP_MARGIN_SHARE * max(np.ptp(east), np.ptp(north)), MAP_MIN_MARGIN_M)
+def _map_view(east: np.ndarray, north: np.ndarray, least_margin: float) -> Bounds:
+    margin = max(MAP_MARGIN_SHARE * max(np.ptp(east), np.ptp(north)), least_margin)
     return (
         float(east.min() - margin),
         float(north.min() - margin),
@@ -356,16 +357,22 @@ def overview_figure(result: ReplayResult, chart: Chart | None) -> Figure:
     ``pair`` column (``place_labels``); each number links to ``#pair-N``."""
     frame = result.frame
     numbers = pair_numbers(result)
-    positions = [
-        frame.to_local(
+    lat_lon = [
+        (
             np.array([p.summary.lat_deg_at_trigger_a, p.summary.lat_deg_at_trigger_b]),
             np.array([p.summary.lon_deg_at_trigger_a, p.summary.lon_deg_at_trigger_b]),
         )
         for p in result.pairs
     ]
+    # Pairs spread beyond the run frame's reach (a satellite feed) are mapped in degrees,
+    # longitude against latitude, without the chart.
+    in_frame = all(frame.within_reach(lat, lon).all() for lat, lon in lat_lon)
+    positions = [frame.to_local(lat, lon) if in_frame else (lat, lon) for lat, lon in lat_lon]
+    if not in_frame:
+        chart = None
     north = np.concatenate([n for n, _ in positions])
     east = np.concatenate([e for _, e in positions])
-    view = _map_view(east, north)
+    view = _map_view(east, north, MAP_MIN_MARGIN_M if in_frame else MAP_MIN_MARGIN_DEG)
     left, right, bottom, top = MAP_MARGINS_IN
     map_height_in = MAP_HEIGHT_IN - bottom - top
     view_width_m, view_height_m = view[2] - view[0], view[3] - view[1]
@@ -416,7 +423,11 @@ def overview_figure(result: ReplayResult, chart: Chart | None) -> Figure:
         )
         label.set_url(f"#pair-{text}")
         label.set_gid(f"pair-{text}")
-    geographic_axes(ax, frame)
+    if in_frame:
+        geographic_axes(ax, frame)
+    else:
+        ax.set_xlabel("longitude (°E)")
+        ax.set_ylabel("latitude (°N)")
     if seen:
         ax.legend(loc="best", fontsize="small")
     ax.set_title(

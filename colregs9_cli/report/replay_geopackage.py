@@ -152,17 +152,21 @@ def write_replay_geopackage(path: Path, result: ReplayResult, chart: Chart | Non
     track_rows: list[dict[str, Any]] = []
     cpa_rows: list[dict[str, Any]] = []
     for outcome in outcomes:
-        trigger = outcome.series.iloc[0]
-        for vessel, track, at_tcpa in (
-            ("own", outcome.own_track, outcome.own_at_tcpa_m),
-            ("target", outcome.target_track, outcome.target_at_tcpa_m),
+        # Each outcome's metres are in its own frame (the run's, or the pair's beyond its
+        # reach): its geometries go to WGS84 through that frame.
+        its_points: list[Any] = []
+        its_tracks: list[Any] = []
+        its_cpa: list[Any] = []
+        for vessel, track, at_trigger, at_tcpa in (
+            ("own", outcome.own_track, outcome.own_at_trigger_m, outcome.own_at_tcpa_m),
+            ("target", outcome.target_track, outcome.target_at_trigger_m, outcome.target_at_tcpa_m),
         ):
             mmsi = getattr(outcome.summary, f"{vessel}_mmsi")
-            points.append(shapely.Point(trigger[f"{vessel}_east_m"], trigger[f"{vessel}_north_m"]))
+            its_points.append(shapely.Point(at_trigger[1], at_trigger[0]))
             actions.append(_action_before_cpa_s(outcome.summary, mmsi))
             line = track.dropna()
             if len(line) >= 2:
-                tracks.append(shapely.LineString(line[["east_m", "north_m"]].to_numpy()))
+                its_tracks.append(shapely.LineString(line[["east_m", "north_m"]].to_numpy()))
                 track_rows.append(
                     {
                         "encounter_id": outcome.summary.encounter_id,
@@ -170,7 +174,7 @@ def write_replay_geopackage(path: Path, result: ReplayResult, chart: Chart | Non
                         "mmsi": mmsi,
                     }
                 )
-            cpa.append(shapely.Point(at_tcpa[1], at_tcpa[0]))
+            its_cpa.append(shapely.Point(at_tcpa[1], at_tcpa[0]))
             cpa_rows.append(
                 {
                     "encounter_id": outcome.summary.encounter_id,
@@ -179,15 +183,18 @@ def write_replay_geopackage(path: Path, result: ReplayResult, chart: Chart | Non
                     "tcpa_s": outcome.summary.tcpa_s,
                 }
             )
+        points.extend(_to_wgs84(outcome.frame, its_points))
+        tracks.extend(_to_wgs84(outcome.frame, its_tracks))
+        cpa.extend(_to_wgs84(outcome.frame, its_cpa))
     # Each encounter row twice, own ship's point then the target's.
     table = _encounter_table(outcomes)
     point_rows = table.loc[table.index.repeat(2)].reset_index(drop=True)
     point_rows = point_rows.assign(
         action_before_cpa_s=actions, vessel=["own", "target"] * len(outcomes)
     )
-    layers["encounters"] = (_to_wgs84(frame, points), point_rows)
-    layers["tracks"] = (_to_wgs84(frame, tracks), pd.DataFrame(track_rows))
-    layers["cpa"] = (_to_wgs84(frame, cpa), pd.DataFrame(cpa_rows))
+    layers["encounters"] = (np.asarray(points, dtype=object), point_rows)
+    layers["tracks"] = (np.asarray(tracks, dtype=object), pd.DataFrame(track_rows))
+    layers["cpa"] = (np.asarray(cpa, dtype=object), pd.DataFrame(cpa_rows))
     domains: list[Any] = []
     domain_rows: list[pd.DataFrame] = []
     for outcome in outcomes:

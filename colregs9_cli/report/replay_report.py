@@ -198,7 +198,7 @@ def _view_box(outcome: EncounterOutcome) -> Bounds:
             outcome.own_track["east_m"].to_numpy(),
             outcome.target_track["east_m"].to_numpy(),
             [outcome.own_at_tcpa_m[1], outcome.target_at_tcpa_m[1]],
-            outcome.assessment.east_m,
+            outcome.assessment.east_m if outcome.in_run_frame else [],
         ]
     )
     north = np.concatenate(
@@ -206,7 +206,7 @@ def _view_box(outcome: EncounterOutcome) -> Bounds:
             outcome.own_track["north_m"].to_numpy(),
             outcome.target_track["north_m"].to_numpy(),
             [outcome.own_at_tcpa_m[0], outcome.target_at_tcpa_m[0]],
-            outcome.assessment.north_m,
+            outcome.assessment.north_m if outcome.in_run_frame else [],
         ]
     )
     centre_east = (np.nanmin(east) + np.nanmax(east)) / 2.0
@@ -222,12 +222,8 @@ def _view_box(outcome: EncounterOutcome) -> Bounds:
 
 
 def trigger_positions_m(outcome: EncounterOutcome) -> tuple[tuple[float, float], ...]:
-    """Own ship's and the target's (north, east) at the trigger: the first row of the series."""
-    trigger = outcome.series.iloc[0]
-    return (
-        (float(trigger["own_north_m"]), float(trigger["own_east_m"])),
-        (float(trigger["target_north_m"]), float(trigger["target_east_m"])),
-    )
+    """Own ship's and the target's (north, east) at the trigger, in the outcome's frame."""
+    return outcome.own_at_trigger_m, outcome.target_at_trigger_m
 
 
 def direction_arrows(
@@ -425,6 +421,9 @@ def encounter_figure(
     s = outcome.summary
     figure, ax = plt.subplots(figsize=(8.5, 9.2), layout="constrained")
     view = _view_box(outcome)
+    # The chart lives in the run's frame; a pair beyond its reach has a frame of its own.
+    if not outcome.in_run_frame:
+        chart, frame = None, outcome.frame
     if chart is not None:
         depths = draw_chart(ax, chart, s.target_draught_m, ukc_m, view=view)
         figure.colorbar(depths, ax=ax, label=DEPTH_LABEL, shrink=0.6, pad=0.02)
@@ -447,8 +446,10 @@ def encounter_figure(
     early = not s.data_covers_cpa
     _mark_data_end(ax, outcome.own_track, OWN_TRACK_COLOUR, "own ship", early)
     _mark_data_end(ax, outcome.target_track, TARGET_COLOUR, "target", early)
-    steps_per_arc = int(outcome.assessment.step.max(initial=1))
-    draw_assessment(ax, outcome.assessment, every=math.ceil(steps_per_arc / OUTLINES_PER_ARC))
+    if outcome.in_run_frame:
+        steps_per_arc = int(outcome.assessment.step.max(initial=1))
+        every = math.ceil(steps_per_arc / OUTLINES_PER_ARC)
+        draw_assessment(ax, outcome.assessment, every=every)
     own_at_trigger_m, target_at_trigger_m = trigger_positions_m(outcome)
     _draw_positions(
         ax, "own ship", own_at_trigger_m, outcome.own_at_tcpa_m, OWN_DOT_COLOUR, OWN_TRACK_COLOUR
