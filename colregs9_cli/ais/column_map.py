@@ -42,30 +42,13 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParameterError
+from .schema import CANONICAL_COLUMNS
 
 MAP_PREFIX = "columns:"
 TIME_UNIX = "unix"
 TIME_UNIX_MS = "unix_ms"
 
-CANONICAL_TARGETS = (
-    "timestamp",
-    "mmsi",
-    "lat_deg",
-    "lon_deg",
-    "sog_kn",
-    "cog_deg",
-    "heading_deg",
-    "rot_deg_per_min",
-    "nav_status",
-    "ship_type",
-    "mobile_type",
-    "length_m",
-    "breadth_m",
-    "draught_m",
-    "name",
-    "callsign",
-    "imo",
-)
+CANONICAL_TARGETS = CANONICAL_COLUMNS
 PART_TARGETS = ("to_bow", "to_stern", "to_port", "to_starboard")
 EXTRA_TARGETS = (*PART_TARGETS, "message_type", "millisecond")
 TARGETS = (*CANONICAL_TARGETS, *EXTRA_TARGETS)
