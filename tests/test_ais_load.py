@@ -197,3 +197,22 @@ def test_small_chunks_and_batches_change_nothing_on_generated_dma(
     pd.testing.assert_frame_equal(pieces.dimension_reports, whole.dimension_reports)
     counts = {k: v for k, v in whole.ledger.to_dict().items() if k != "reject_examples"}
     assert {k: v for k, v in pieces.ledger.to_dict().items() if k != "reject_examples"} == counts
+
+
+def test_a_quote_left_open_costs_its_lines_and_loses_none(tmp_path: Path) -> None:
+    # pyarrow reads a quoted field across line ends, so a stray quote in a name swallows the
+    # lines after it into one malformed record: each of them is counted read and rejected.
+    lines = DMA26.read_text(encoding="utf-8").splitlines()
+    header, rows = lines[0], lines[1:21]
+    fields = rows[1].split(",")
+    fields[7] = '"BROKEN NAME'
+    rows[1] = ",".join(fields)
+    path = tmp_path / "stray_quote.csv"
+    path.write_text("\n".join([header, *rows]) + "\n", encoding="utf-8")
+    result = load_ais([path])
+    ledger = result.ledger
+    assert ledger.rows_read == 20
+    assert ledger.balanced
+    assert ledger.rejects["unparseable"] == 19
+    (example,) = ledger.examples["unparseable"]
+    assert f"{path}:3:" in example and "a quote left open: 19 lines" in example

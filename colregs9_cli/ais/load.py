@@ -757,11 +757,16 @@ def _non_utf8_error(source: Source) -> InputFileError:
 
 def _csv_chunk(result: _FileResult, spec: _CsvLayout, chunk: CsvChunk) -> None:
     for bad in chunk.invalid_rows:
-        result.ledger.read()
+        # A stray quote makes one malformed record of the lines up to the next quote: each
+        # of those lines is a row read and rejected, not lost inside the record.
+        lines = len(bad.text.splitlines()) or 1
+        spans = f" (a quote left open: {lines} lines)" if lines > 1 else ""
+        result.ledger.read(lines)
         result.ledger.reject(
             RejectReason.UNPARSEABLE,
+            lines,
             example=f"{result.name}:{bad.line}: expected {bad.expected_columns} fields, found "
-            f"{bad.actual_columns}: {bad.text[:_EXAMPLE_CHARS]}",
+            f"{bad.actual_columns}{spans}: {bad.text[:_EXAMPLE_CHARS]}",
         )
     rows = chunk.rows
     result.ledger.read(rows.num_rows)
