@@ -18,6 +18,7 @@ from contextlib import ExitStack, closing, contextmanager
 from pathlib import Path
 
 import dask
+import pyarrow as pa
 from distributed import Client, LocalCluster, as_completed
 
 from .chart import Chart
@@ -67,8 +68,10 @@ def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
 
 
 async def _ready() -> None:
-    """Nothing: unpickling it on a worker imports this module and so the whole replay (a
-    coroutine, as Dask runs only those without waiting)."""
+    """Unpickling it on a worker imports this module and so the whole replay (a coroutine,
+    as Dask runs only those without waiting). A worker is one of the cluster's processes
+    sharing the machine: Arrow's thread pool of one thread per core would oversubscribe it."""
+    pa.set_cpu_count(1)
 
 
 @contextmanager
