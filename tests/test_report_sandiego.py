@@ -13,12 +13,11 @@ import shapely
 from matplotlib.text import Text
 
 from colregs9_cli.chart import load_chart
-from colregs9_cli.replay import run_replay
 from colregs9_cli.report.chart_plot import NOT_CHARTED_LABEL
 from colregs9_cli.report.html_report import overview_figure, pair_numbers, place_labels
 from colregs9_cli.report.replay_report import DEFAULTED_NOTE, encounter_figure
 
-from fixture_files import SANDIEGO_AIS, SANDIEGO_ENC
+from fixture_files import SANDIEGO_ENC
 
 # Own ship SAILEBRATE reports no dimension; the target ECHELON reports all but her draught.
 DEFAULTED = "20220103T000009-338254678-368124990"
@@ -27,10 +26,8 @@ LEAVES_THE_CHART = "20220103T001317-366793760-368103590"
 
 
 @pytest.fixture(scope="module")
-def sandiego(tmp_path_factory: pytest.TempPathFactory):
-    out = tmp_path_factory.mktemp("sandiego-report")
-    result = run_replay([SANDIEGO_AIS], chart_paths=[SANDIEGO_ENC], out_dir=out, plots=False)
-    return result, load_chart([SANDIEGO_ENC], result.frame)
+def sandiego(sandiego_replay):
+    return sandiego_replay, load_chart([SANDIEGO_ENC], sandiego_replay.frame)
 
 
 def _outcome(result, encounter_id: str):

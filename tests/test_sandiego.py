@@ -8,18 +8,15 @@ import json
 import pandas as pd
 import pytest
 
-from colregs9_cli.replay import run_replay
-
-from fixture_files import SANDIEGO_AIS, SANDIEGO_ENC
+from fixture_files import SANDIEGO_AIS
 from seat_checks import assert_seats_agree
 
 TRIGGERED_SEATS = 38  # 19 pairs, each from both seats
 
 
 @pytest.fixture(scope="module")
-def sandiego(tmp_path_factory: pytest.TempPathFactory):
-    out = tmp_path_factory.mktemp("sandiego")
-    return run_replay([SANDIEGO_AIS], chart_paths=[SANDIEGO_ENC], out_dir=out, plots=False)
+def sandiego(sandiego_replay):
+    return sandiego_replay
 
 
 def _table(result, name: str) -> pd.DataFrame:
