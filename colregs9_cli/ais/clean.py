@@ -10,8 +10,6 @@ dimension beyond what ships have or not finite (``MAX_LENGTH_M`` ...; counted as
 
 from __future__ import annotations
 
-import contextvars
-import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -240,21 +238,14 @@ MAX_LENGTH_M = 500.0
 MAX_BREADTH_M = 80.0
 MAX_DRAUGHT_M = 30.0
 _LIMITS_M = (MAX_LENGTH_M, MAX_BREADTH_M, MAX_DRAUGHT_M)
-# The limits ``plausible`` applies: lifted (to infinity, which still drops NaN) only while
-# ``DimensionColumns.implausible`` looks for what they drop.
-_limits_m: contextvars.ContextVar[tuple[float, float, float]] = contextvars.ContextVar(
-    "dimension_limits_m", default=_LIMITS_M
-)
 
 
 def plausible(dimensions: Dimensions) -> Dimensions:
     """Length, breadth and draught with implausible values (module limits) as NaN."""
-    length_m, breadth_m, draught_m = dimensions
-    max_length_m, max_breadth_m, max_draught_m = _limits_m.get()
     return (
-        null_outside(length_m, 0.0, max_length_m),
-        null_outside(breadth_m, 0.0, max_breadth_m),
-        null_outside(draught_m, 0.0, max_draught_m),
+        null_outside(dimensions[0], 0.0, MAX_LENGTH_M),
+        null_outside(dimensions[1], 0.0, MAX_BREADTH_M),
+        null_outside(dimensions[2], 0.0, MAX_DRAUGHT_M),
     )
 
 
@@ -286,38 +277,33 @@ def implausible_text(length_m: float, breadth_m: float, draught_m: float) -> str
 
 @dataclass(frozen=True)
 class DimensionColumns:
-    """A block's dimension columns as read, one row per row, and ``clean``, which turns
-    such columns into length, breadth and draught in metres (NaN = not available).
+    """A block's dimension columns as read, one row per row, and ``measure``, the reader's
+    way of turning such columns into length, breadth and draught in metres (A+B, or Length;
+    NaN = not available) before the module limits; ``clean`` applies them (``plausible``).
 
     Cleaning is left until it is needed: a vessel repeats its dimensions in row after row,
     so the pipeline counts the distinct rows as read and cleans only those.
     """
 
     table: pa.Table
-    clean: Callable[[pa.Table], Dimensions]
+    measure: Callable[[pa.Table], Dimensions]
+
+    def clean(self, table: pa.Table) -> Dimensions:
+        """The dimensions of ``table`` (columns as ``self.table``'s, more may follow), with
+        the implausible ones dropped."""
+        return plausible(self.measure(table))
 
     def of_rows(self, rows: NDArray[np.int64]) -> Dimensions:
         return self.clean(self.table.take(pa.array(rows, pa.int64())))
 
-    def unbounded(self, table: pa.Table | None = None) -> Dimensions:
-        """The reader's own cleaning of ``table`` (columns as ``self.table``'s, more may
-        follow; default ``self.table``) with the module limits lifted: every layout's way
-        of making a dimension (A+B, or Length), before the implausible values are dropped."""
-        rows = self.table if table is None else table
-        token = _limits_m.set((math.inf, math.inf, math.inf))
-        try:
-            return self.clean(rows)
-        finally:
-            _limits_m.reset(token)
-
-    def unbounded_rows(self, rows: NDArray[np.int64]) -> Dimensions:
-        """``unbounded`` for some rows of ``self.table`` (indices)."""
-        return self.unbounded(self.table.take(pa.array(rows, pa.int64())))
+    def measured_rows(self, rows: NDArray[np.int64]) -> Dimensions:
+        """``measure`` for some rows of ``self.table`` (indices): before the limits."""
+        return self.measure(self.table.take(pa.array(rows, pa.int64())))
 
     def implausible(self, table: pa.Table | None = None) -> BoolArray:
-        """Which rows of ``table`` (as for ``unbounded``) report a dimension that cleaning
-        drops as implausible: beyond the module limits or not finite."""
-        return implausible(self.unbounded(table))
+        """Which rows of ``table`` (default ``self.table``) report a dimension that
+        ``clean`` drops as implausible: beyond the module limits or not finite."""
+        return implausible(self.measure(self.table if table is None else table))
 
     def implausible_rows(self, rows: NDArray[np.int64]) -> BoolArray:
         """``implausible`` for some rows of ``self.table`` (indices)."""

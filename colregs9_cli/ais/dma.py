@@ -45,16 +45,15 @@ DMA_TIME_FORMAT = "%d/%m/%Y %H:%M:%S"
 
 
 def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
-    """Length and breadth from A+B and C+D where both are given, else from Length and Width."""
+    """Length and breadth from A+B and C+D where both are given, else from Length and Width
+    (before the plausibility limits, which ``DimensionColumns.clean`` applies)."""
     width, _ = float_column(batch.column("width"))
     length, _ = float_column(batch.column("length"))
     draught, _ = float_column(batch.column("draught"))
     if has_abcd:
         a, b, c, d = (float_column(batch.column(k))[0] for k in DMA_ABCD)
-        return plausible(
-            (dimension(a, b, length), dimension(c, d, width), positive_or_nan(draught))
-        )
-    return plausible((positive_or_nan(length), positive_or_nan(width), positive_or_nan(draught)))
+        return dimension(a, b, length), dimension(c, d, width), positive_or_nan(draught)
+    return positive_or_nan(length), positive_or_nan(width), positive_or_nan(draught)
 
 
 def dma_fields(batch: pa.RecordBatch, has_abcd: bool) -> Fields:
@@ -100,7 +99,7 @@ def dma_canonical(batch: pa.RecordBatch, has_abcd: bool) -> tuple[pa.Table, Bool
     mmsi, _ = mmsi_column(batch.column("mmsi"))
     lat, _ = float_column(batch.column("latitude"))
     lon, _ = float_column(batch.column("longitude"))
-    length, breadth, draught = _dimensions(batch, has_abcd)
+    length, breadth, draught = plausible(_dimensions(batch, has_abcd))
     imo, _ = float_column(clean_text(batch.column("imo")))
     table = pa.table(
         {

@@ -78,6 +78,7 @@ from .clean import (
     Fields,
     any_dimension,
     clean_text,
+    implausible,
     implausible_text,
     is_vessel,
     null_outside,
@@ -314,7 +315,7 @@ def _dataset_reports(dataset: Dataset, vessels: np.ndarray) -> pa.Table:
         groups = table.group_by(table.column_names, use_threads=False).aggregate(
             [([], "count_all")]
         )
-        length_m, breadth_m, draught_m = _canonical_dimensions(groups)
+        length_m, breadth_m, draught_m = plausible(_canonical_dimensions(groups))
         reported = any_dimension(length_m, breadth_m, draught_m)
         parts.append(
             _report_rows(
@@ -539,7 +540,7 @@ class _FileResult:
     def _uncount_dimensions(self, rows: pa.Table) -> None:
         """Take back the dimensions counted for canonical ``rows`` that were rejected after
         their block was counted."""
-        length_m, breadth_m, draught_m = _canonical_dimensions(rows)
+        length_m, breadth_m, draught_m = plausible(_canonical_dimensions(rows))
         reported = any_dimension(length_m, breadth_m, draught_m)
         if reported.any():
             mmsi = rows.column("mmsi").to_numpy()[reported]
@@ -572,10 +573,11 @@ def _count_reports(
     keyed = dimensions.table.append_column(key, pa.array(np.where(rows, mmsi, -1), pa.int64()))
     groups = keyed.group_by(keyed.column_names, use_threads=False).aggregate([([], "count_all")])
     groups = groups.filter(pc.not_equal(groups.column(key), -1))
-    length_m, breadth_m, draught_m = dimensions.clean(groups)
+    measured = dimensions.measure(groups)
+    length_m, breadth_m, draught_m = plausible(measured)
     reported = any_dimension(length_m, breadth_m, draught_m)
     times = groups.column("count_all").to_numpy()
-    implausible = int(times[dimensions.implausible(groups)].sum())
+    implausible_count = int(times[implausible(measured)].sum())
     counts = _report_rows(
         groups.column(key).to_numpy()[reported],
         length_m[reported],
@@ -583,14 +585,14 @@ def _count_reports(
         draught_m[reported],
         times[reported],
     )
-    return counts, implausible
+    return counts, implausible_count
 
 
 def _implausible_example(dimensions: DimensionColumns, rows: np.ndarray, example: Example) -> str:
     """The first of ``rows`` (a mask) with an implausible dimension, quoted with its values."""
     candidates = np.flatnonzero(rows)
     first = int(candidates[np.argmax(dimensions.implausible_rows(candidates))])
-    length_m, breadth_m, draught_m = dimensions.unbounded_rows(np.array([first]))
+    length_m, breadth_m, draught_m = dimensions.measured_rows(np.array([first]))
     what = implausible_text(float(length_m[0]), float(breadth_m[0]), float(draught_m[0]))
     return example(first, "MMSI", f"implausible dimension dropped ({what}): MMSI")
 
@@ -933,8 +935,9 @@ def _in_query(table: pa.Table, query: Query) -> np.ndarray:
 
 
 def _canonical_dimensions(table: pa.Table) -> Dimensions:
+    """The canonical columns as numbers, before the plausibility limits."""
     length_m, breadth_m, draught_m = (to_numpy_float(table.column(name)) for name in DIMENSIONS)
-    return plausible((length_m, breadth_m, draught_m))
+    return length_m, breadth_m, draught_m
 
 
 def _canonical_fields(table: pa.Table) -> Fields:

@@ -101,11 +101,12 @@ def _number(map_: ColumnMap, batch: Batch, target: str) -> tuple[FloatArray, Boo
 
 
 def _dimensions(map_: ColumnMap, batch: Batch) -> Dimensions:
+    """The dimensions as the map makes them, before the plausibility limits."""
     length, _ = _number(map_, batch, "length_m")
     breadth, _ = _number(map_, batch, "breadth_m")
     draught, _ = _number(map_, batch, "draught_m")
     a, b, c, d = (_number(map_, batch, t)[0] for t in PART_TARGETS)
-    return plausible((dimension(a, b, length), dimension(c, d, breadth), positive_or_nan(draught)))
+    return dimension(a, b, length), dimension(c, d, breadth), positive_or_nan(draught)
 
 
 def _message_types(map_: ColumnMap, batch: Batch) -> FloatArray:
@@ -253,7 +254,7 @@ def mapped_canonical(map_: ColumnMap, batch: Batch) -> tuple[pa.Table, BoolArray
     lon, _ = _number(map_, batch, "lon_deg")
     imo_text = pc.utf8_ltrim(pc.utf8_upper(_text(map_, batch, "imo")), characters="IMO ")
     imo, _ = float_column(imo_text)
-    length, breadth, draught = _dimensions(map_, batch)
+    length, breadth, draught = plausible(_dimensions(map_, batch))
     table = pa.table(
         {
             "timestamp": stamps,
