@@ -66,10 +66,7 @@ class RejectsLedger:
         if n <= 0:
             return
         self.rejects[reason.value] += n
-        if example is not None:
-            bucket = self.examples.setdefault(reason.value, [])
-            if len(bucket) < self.max_examples:
-                bucket.append(example)
+        self._keep_example(self.examples, reason.value, example)
 
     def wants_example(self, reason: RejectReason | DropReason) -> bool:
         """Whether an example of ``reason`` would still be kept (to skip building it)."""
@@ -81,8 +78,13 @@ class RejectsLedger:
         if n <= 0:
             return
         self.dropped[reason.value] += n
+        self._keep_example(self.dropped_examples, reason.value, example)
+
+    def _keep_example(
+        self, examples: dict[str, list[str]], reason: str, example: str | None
+    ) -> None:
         if example is not None:
-            bucket = self.dropped_examples.setdefault(reason.value, [])
+            bucket = examples.setdefault(reason, [])
             if len(bucket) < self.max_examples:
                 bucket.append(example)
 
