@@ -46,11 +46,17 @@ def flush_streams(status: int) -> int:
     return status
 
 
+def fewer_collections() -> None:
+    """Collect the youngest generation every ``GC_YOUNG_THRESHOLD`` allocations: in the
+    console script, and in the Dask workers of a replay, which hold the same objects."""
+    _, older, oldest = gc.get_threshold()
+    gc.set_threshold(GC_YOUNG_THRESHOLD, older, oldest)
+
+
 def run_and_exit(main: Callable[[], object]) -> NoReturn:
     """Run ``main`` (a Click or Typer app, which ends with ``SystemExit``), then leave at once
     with its status. Any other exception propagates, with its traceback, as usual."""
-    _, older, oldest = gc.get_threshold()
-    gc.set_threshold(GC_YOUNG_THRESHOLD, older, oldest)
+    fewer_collections()
     try:
         main()
         status = 0

@@ -76,7 +76,7 @@ from .manoeuvrability import (
 )
 from .progress import progress_bar, progress_enabled
 from .query import Query, everything_query, load_query
-from .replay_input import open_replay_input
+from .replay_input import open_replay_input, segment_input_part
 from .replay_params import ReplayParams, replay_params_from_table
 from .replay_results import (
     SERIES_COLUMNS,
@@ -100,7 +100,6 @@ from .slabs import (
     SlabContext,
     SlabResult,
     run_slabs,
-    segment_slabs,
 )
 from .tracks import REQUIRED_COLUMNS, STATIC_COLUMNS, Tracks, TrackStats, context_s
 from .vessel_defaults import VesselDimensions, vessel_dimensions
@@ -939,8 +938,22 @@ def run_replay(
             ais = open_replay_input(
                 ais_paths, query, fmt, quiet, Path(scratch), slab_s, REPLAY_COLUMNS
             )
-            with progress_bar("Tracks (slabs)", len(ais.slabs), progress_enabled(quiet)) as bar:
-                segmentation = segment_slabs(ais.positions(), spill_dir, params.replay, bar)
+            # Stage 1 in parts of the vessels, one per worker on a cluster (the results do not
+            # depend on their number); the bar counts the slabs of one part, else the parts.
+            parts = ais.parts(1 if cluster is None else len(cluster().nthreads()))
+            unit, units = ("slabs", len(ais.slabs)) if len(parts) == 1 else ("parts", len(parts))
+            with progress_bar(f"Tracks ({unit})", units, progress_enabled(quiet)) as bar:
+                if cluster is None or len(parts) == 1:
+                    done = [segment_input_part(parts[0], 0, spill_dir, params.replay, bar)]
+                else:
+                    from .dask_run import dask_segments
+
+                    tasks = [
+                        functools.partial(segment_input_part, part, k, spill_dir, params.replay)
+                        for k, part in enumerate(parts)
+                    ]
+                    done = dask_segments(cluster(), tasks, bar)
+            segmentation = ais.merge(done)
             ais.check_positions()
             if len(ais.vessels) < 2:
                 raise NoDataError(
@@ -965,7 +978,9 @@ def run_replay(
                 else:
                     from .dask_run import dask_slabs
 
-                    results = dask_slabs(cluster(), slabs, context, evaluate, chart, bar)
+                    results, on_cluster = dask_slabs(
+                        cluster(), slabs, context, evaluate, chart, bar
+                    )
         outcomes = [pair for result in results for pair in result.pairs]
         ledger = _ledger_with_tracks(ais.ledger, segmentation.stats)
         track_stats = dataclasses.replace(
@@ -1010,7 +1025,7 @@ def run_replay(
                     from .dask_run import dask_drawer
 
                     drawer = dask_drawer(cluster())
-                    files = write_replay_reports(result, chart, plots, bar, drawer)
+                    files = write_replay_reports(result, chart, plots, bar, drawer, on_cluster)
         return dataclasses.replace(result, files=files, text=format_summary(result))
 
 

@@ -6,6 +6,7 @@ time-series columns, and the run's result. Below both ``replay`` (which fills th
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -291,10 +292,16 @@ class ReplayResult:
     @property
     def encounters(self) -> tuple[EncounterOutcome, ...]:
         """Every reported seat, ordered by start, own MMSI and target MMSI."""
-        seats = [seat for pair in self.pairs for seat in pair.seats]
-        return tuple(
-            sorted(
-                seats,
-                key=lambda o: (o.summary.start_utc, o.summary.own_mmsi, o.summary.target_mmsi),
-            )
+        return seats_in_order(self.pairs)
+
+
+def seats_in_order(pairs: Sequence[PairOutcome]) -> tuple[EncounterOutcome, ...]:
+    """The pairs' seats ordered by start, own MMSI and target MMSI: the order of the reports'
+    rows. Slabs own the encounters that start in them, so the seats of consecutive slabs,
+    each ordered, follow one another in this order."""
+    seats = [seat for pair in pairs for seat in pair.seats]
+    return tuple(
+        sorted(
+            seats, key=lambda o: (o.summary.start_utc, o.summary.own_mmsi, o.summary.target_mmsi)
         )
+    )

@@ -1,11 +1,14 @@
 """Replay through time in slabs, in bounded memory, with the results of one go (DESIGN §6).
 
-**Stage 1, segmentation** (``segment_slabs``, one pass in time order): the positions of each
+**Stage 1, segmentation** (``segment_part``, one pass in time order): the positions of each
 slab are segmented (``tracks.segment_reports``, which carries each vessel's last kept report
 from slab to slab, so every report is decided as in one go) and the decided reports are
 spilled to one Parquet file per slab in a scratch directory. On the way it gathers the
-vessels' static data, the extent of the data (for the run's frame), a few positions per
-0.01° cell (to check that a chart covers the AIS) and the counts.
+vessels' static data, the extent of the data (for the run's frame), a position per 0.01°
+cell (to check that a chart covers the AIS) and the counts. Segmentation is a matter of
+each vessel alone, so the vessels may be cut into parts (``replay_input.ReplayInput.parts``)
+segmented apart, in any process: ``merge_parts`` makes of the parts' results what one part
+gives (sums, unions, minima and maxima; nothing depends on the order positions come in).
 
 **Stage 2, the slabs** (``replay_slab``, a pure function of its ``SlabJob``: slabs run in any
 order and in any process): a slab owns the encounters that start in its core, ``[k·slab_s,
@@ -75,7 +78,8 @@ class SpillFile:
 
 @dataclass(frozen=True)
 class Spill:
-    """The decided reports of stage 1, one Parquet file per slab (``KEPT_COLUMNS``)."""
+    """The decided reports of stage 1, a Parquet file per slab and part of the vessels
+    (``KEPT_COLUMNS``)."""
 
     files: tuple[SpillFile, ...]
 
@@ -130,23 +134,48 @@ class Extent:
         lon0 = math.degrees(math.atan2(self.lon_sin_sum, self.lon_cos_sum))
         return LocalFrame((self.lat_min_deg + self.lat_max_deg) / 2.0, lon0)
 
+    def merge(self, other: Extent) -> None:
+        """Add the data of ``other``: the same extent whatever the order they are added in."""
+        self.lat_min_deg = min(self.lat_min_deg, other.lat_min_deg)
+        self.lat_max_deg = max(self.lat_max_deg, other.lat_max_deg)
+        self.lon_sin_sum += other.lon_sin_sum
+        self.lon_cos_sum += other.lon_cos_sum
 
-@dataclass
-class _Points:
-    """At most one position per ``_POINT_CELL_DEG`` cell: the first one seen."""
 
-    cells: dict[tuple[int, int], tuple[float, float]] = field(default_factory=dict)
+@dataclass(frozen=True)
+class Points:
+    """One position in each ``_POINT_CELL_DEG`` cell with data, in the order of the cells: the
+    cell's smallest (lat, lon). The choice does not depend on the order positions come in,
+    so that the points of parts of the vessels add up (``+``) to those of all of them."""
 
-    def add(self, lat_deg: NDArray[np.float64], lon_deg: NDArray[np.float64]) -> None:
+    lat_deg: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+    lon_deg: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
+
+    @classmethod
+    def of(cls, lat_deg: NDArray[np.float64], lon_deg: NDArray[np.float64]) -> Points:
         row = np.floor(lat_deg / _POINT_CELL_DEG).astype(np.int64)
         column = np.floor(lon_deg / _POINT_CELL_DEG).astype(np.int64)
-        _, first = np.unique(row * 100_000 + column, return_index=True)
-        for i in first:
-            self.cells.setdefault((int(row[i]), int(column[i])), (lat_deg[i], lon_deg[i]))
+        cell = row * 100_000 + column
+        if len(cell) == 0:
+            return cls()
+        order = np.argsort(cell, kind="stable")
+        cell, lat_deg, lon_deg = cell[order], lat_deg[order], lon_deg[order]
+        first_of_cell = np.ones(len(cell), dtype=bool)
+        first_of_cell[1:] = cell[1:] != cell[:-1]
+        starts = np.flatnonzero(first_of_cell)
+        lat_min = np.minimum.reduceat(lat_deg, starts)
+        of_cell = np.cumsum(first_of_cell) - 1
+        lon_at_lat_min = np.where(lat_deg == lat_min[of_cell], lon_deg, np.inf)
+        return cls(lat_min, np.minimum.reduceat(lon_at_lat_min, starts))
+
+    def __add__(self, other: Points) -> Points:
+        return Points.of(
+            np.concatenate((self.lat_deg, other.lat_deg)),
+            np.concatenate((self.lon_deg, other.lon_deg)),
+        )
 
     def frame(self) -> pd.DataFrame:
-        values = np.asarray(list(self.cells.values()), dtype=float).reshape(-1, 2)
-        return pd.DataFrame({"lat_deg": values[:, 0], "lon_deg": values[:, 1]})
+        return pd.DataFrame({"lat_deg": self.lat_deg, "lon_deg": self.lon_deg})
 
 
 @dataclass(frozen=True)
@@ -183,19 +212,41 @@ def slab_label(index: int, slab_s: float) -> str:
     return start.strftime("%Y-%m-%d %H:%M:%S UTC")
 
 
-def segment_slabs(
+@dataclass(frozen=True)
+class SegmentedPart:
+    """Stage 1's result for one part of the vessels (``segment_part``), as a ``Segmentation``
+    holds it for all of them (``merge_parts``)."""
+
+    files: tuple[SpillFile, ...]
+    statics: pd.DataFrame
+    vessels: NDArray[np.int64]
+    extent: Extent
+    points: Points
+    first_s: float
+    last_s: float
+    stats: TrackStats
+
+
+def segment_part(
     slabs: Iterable[tuple[int, pd.DataFrame]],
+    part: int,
     spill_dir: Path,
     params: ReplayParams,
-    bar: ProgressSink,
-) -> Segmentation:
-    """Stage 1 over the slabs' positions, given in increasing slab order (canonical
-    columns, cleaned; see ``tracks.report_table``)."""
+    bar: ProgressSink | None = None,
+) -> SegmentedPart:
+    """Stage 1 over the slabs' positions of part ``part`` of the vessels, given in increasing
+    slab order (canonical columns, cleaned; see ``tracks.report_table``); ``bar`` advanced
+    by slab. Its spill files are its own (named by slab and part): the parts may run at
+    once, in any processes.
+
+    A part skips the slabs without positions of its vessels. Segmenting such a slab would
+    only drop a vessel's pending jump once no report can come in time to confirm it; its
+    next report, later still, drops it all the same."""
     carry = empty_carry()
     stats = NO_TRACK_STATS
     statics: pd.DataFrame | None = None
     extent = Extent()
-    points = _Points()
+    points = Points()
     files: list[SpillFile] = []
     vessels: set[int] = set()
     first_s, last_s = math.inf, -math.inf
@@ -208,32 +259,54 @@ def segment_slabs(
         lat = reports["lat_deg"].to_numpy()
         lon = reports["lon_deg"].to_numpy()
         extent.add(lat, lon)
-        points.add(lat, lon)
+        points += Points.of(lat, lon)
         statics = latest_statics(positions, statics)
+        # After the part's last slab its vessels have no more reports, whatever other parts
+        # have: their pending jumps are decided here, as one part decides them later.
         until_s = None if following is None else (index + 1) * params.slab_s
         segmented = segment_reports(reports, carry, params, until_s)
         carry = segmented.carry
         stats = stats + segmented.stats
         kept = segmented.kept
         if len(kept):
-            path = spill_dir / f"slab-{index:012d}.parquet"
+            path = spill_dir / f"slab-{index:012d}-{part}.parquet"
             pq.write_table(pa.Table.from_pandas(kept, preserve_index=False), path)
             t = kept["t_s"].to_numpy()
             files.append(SpillFile(path, float(t.min()), float(t.max())))
             first_s, last_s = min(first_s, float(t.min())), max(last_s, float(t.max()))
             vessels.update(np.unique(kept["mmsi"].to_numpy()).tolist())
-        bar.advance()
-        bar.describe(slab_label(index, params.slab_s))
+        if bar is not None:
+            bar.advance()
+            bar.describe(slab_label(index, params.slab_s))
         current = following
-    return Segmentation(
-        spill=Spill(tuple(files)),
+    return SegmentedPart(
+        files=tuple(files),
         statics=statics if statics is not None else pd.DataFrame(),
         vessels=np.asarray(sorted(vessels), dtype=np.int64),
         extent=extent,
-        points=points.frame(),
+        points=points,
         first_s=first_s,
         last_s=last_s,
         stats=stats,
+    )
+
+
+def merge_parts(parts: Sequence[SegmentedPart]) -> Segmentation:
+    """The ``Segmentation`` of the vessels of ``parts`` (of distinct vessels, at least one):
+    the same for any cut of the vessels into parts."""
+    extent = Extent()
+    for part in parts:
+        extent.merge(part.extent)
+    statics = [part.statics for part in parts if len(part.statics)]
+    return Segmentation(
+        spill=Spill(tuple(sorted((f for p in parts for f in p.files), key=lambda f: f.path))),
+        statics=pd.concat(statics).sort_index() if statics else pd.DataFrame(),
+        vessels=np.unique(np.concatenate([part.vessels for part in parts])),
+        extent=extent,
+        points=sum((part.points for part in parts), Points()).frame(),
+        first_s=min(part.first_s for part in parts),
+        last_s=max(part.last_s for part in parts),
+        stats=sum((part.stats for part in parts), NO_TRACK_STATS),
     )
 
 

@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pyogrio
 import pytest
 from typer.testing import CliRunner
 
@@ -38,8 +39,21 @@ def _report_files(out: Path) -> dict[str, bytes]:
     }
 
 
+def _map_layers(path: Path) -> dict[str, tuple[list[str], list[bytes], list[list[object]]]]:
+    """The GeoPackage's map layers: fields, geometries and values (the QGIS styles, stamped
+    with the time they were written, left out)."""
+    layers = {}
+    for layer in pyogrio.list_layers(path)[:, 0]:
+        meta, _, wkb, fields = pyogrio.raw.read(path, layer=layer, datetime_as_string=True)
+        if wkb is not None:
+            values = [[None if v != v else v for v in column.tolist()] for column in fields]
+            layers[str(layer)] = (list(meta["fields"]), list(wkb), values)
+    return layers
+
+
 def test_two_workers_write_what_one_writes(tmp_path: Path) -> None:
-    """A LocalCluster of two processes, figures included: the same files, byte for byte,
+    """A LocalCluster of two processes, figures included: the same files, byte for byte
+    (the GeoPackage feature for feature: its series and map layers are made on the workers),
     the encounters in the same order, and nothing on stderr."""
     one = _replay(tmp_path / "one")
     two = _replay(tmp_path / "two", "--workers", "2")
@@ -49,6 +63,9 @@ def test_two_workers_write_what_one_writes(tmp_path: Path) -> None:
     files = _report_files(tmp_path / "one")
     assert sum(name.endswith(".png") for name in files) >= 2
     assert _report_files(tmp_path / "two") == files
+    layers = _map_layers(tmp_path / "one" / "report.gpkg")
+    assert {"encounters", "tracks", "domains"} <= layers.keys()
+    assert _map_layers(tmp_path / "two" / "report.gpkg") == layers
     assert one.stdout.replace(str(tmp_path / "one"), "") == two.stdout.replace(
         str(tmp_path / "two"), ""
     )

@@ -124,9 +124,9 @@ def test_the_slabs_are_read_from_the_dataset_one_window_at_a_time(
     windows: list[timedelta] = []
     read = replay_input.read_window_counted
 
-    def recording(dataset, query, start, end, columns):  # type: ignore[no-untyped-def]
+    def recording(dataset, query, start, end, columns, mmsis):  # type: ignore[no-untyped-def]
         windows.append(end - start)
-        return read(dataset, query, start, end, columns)
+        return read(dataset, query, start, end, columns, mmsis)
 
     monkeypatch.setattr(replay_input, "read_window_counted", recording)
     result = run_replay([nmea_dataset], overrides={"replay": {"slab_s": 60.0}}, write=False)

@@ -3,6 +3,8 @@ legend, chart and view, the overview map, and the GeoPackage's field types."""
 
 from __future__ import annotations
 
+import dataclasses
+import itertools
 import re
 
 import numpy as np
@@ -201,3 +203,72 @@ def test_geopackage_fields_are_typed_as_their_values(sandiego) -> None:
         expected = float(given[mmsi]) if given.get(mmsi) else np.nan
         np.testing.assert_equal(columns["action_before_cpa_s"][i], expected)
     assert np.isfinite(columns["action_before_cpa_s"]).sum() > 0
+
+
+class _InChunks:
+    """``EncounterParts`` of consecutive chunks of the encounters, as slabs on workers give
+    them: uneven, some holding a single seat."""
+
+    def __init__(self, encounters, cuts: list[int]) -> None:
+        bounds = [0, *cuts, len(encounters)]
+        self.parts = [encounters[a:b] for a, b in itertools.pairwise(bounds)]
+
+    def map(self, function):
+        results = [function(part) for part in self.parts]
+        return [lambda result=result: result for result in results]
+
+
+def _layers(path):
+    layers = {}
+    for layer in pyogrio.list_layers(path)[:, 0]:
+        meta, _, wkb, fields = pyogrio.raw.read(path, layer=layer, datetime_as_string=True)
+        if wkb is None:  # the QGIS styles, stamped with the time they were written
+            continue
+        layers[layer] = (
+            list(meta["fields"]),
+            list(meta["dtypes"]),
+            list(wkb),
+            pd.DataFrame(dict(zip(meta["fields"], fields, strict=True))),
+        )
+    return layers
+
+
+def test_reports_made_in_parts_are_the_reports_made_whole(sandiego, tmp_path) -> None:
+    """The series CSVs and the GeoPackage's layers made part by part (each slab's on the
+    worker that holds it) are those made from all the encounters at once."""
+    from colregs9_cli.progress import progress_bar
+    from colregs9_cli.report.replay_geopackage import encounter_layers, join_layers
+    from colregs9_cli.report.replay_report import write_replay_reports
+
+    result, chart = sandiego
+    encounters = result.encounters
+    cuts = [1, 2, 9, len(encounters) - 1]
+    whole = encounter_layers(encounters, result.frame)
+    joined = join_layers(
+        [encounter_layers(part, result.frame) for part in _InChunks(encounters, cuts).parts]
+    )
+    assert joined.keys() == whole.keys()
+    for name, (wkb, table) in whole.items():
+        assert list(joined[name][0]) == list(wkb), name
+        pd.testing.assert_frame_equal(joined[name][1], table, check_dtype=True)
+
+    written = {}
+    for label, parts in (("whole", None), ("parts", _InChunks(encounters, cuts))):
+        out = tmp_path / label
+        with progress_bar("Reports", None, enabled=False) as bar:
+            write_replay_reports(
+                dataclasses.replace(result, out_dir=out), chart, False, bar, parts=parts
+            )
+        written[label] = out
+    series = sorted((written["whole"] / "encounters").iterdir())
+    assert len(series) == len(encounters)
+    for path in series:
+        assert (written["parts"] / "encounters" / path.name).read_bytes() == path.read_bytes()
+    whole_layers = _layers(written["whole"] / "report.gpkg")
+    parts_layers = _layers(written["parts"] / "report.gpkg")
+    assert (
+        whole_layers.keys() == parts_layers.keys() >= {"encounters", "domains", "navigable_water"}
+    )
+    for name, (fields, dtypes, wkb, table) in whole_layers.items():
+        assert parts_layers[name][:3] == (fields, dtypes, wkb), name
+        pd.testing.assert_frame_equal(parts_layers[name][3], table)

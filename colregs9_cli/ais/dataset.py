@@ -49,6 +49,7 @@ import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
+import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 
 from .. import __version__
@@ -600,13 +601,18 @@ def read_window_counted(
     start: datetime,
     end: datetime,
     columns: Sequence[str] | None = None,
+    mmsis: tuple[int, int] | None = None,
 ) -> tuple[pa.Table, pa.Table]:
     """``read_dataset_window``, and the rows in the window and the query that were
-    dropped as exact duplicates (of rows of another input)."""
+    dropped as exact duplicates (of rows of another input). ``mmsis``: only the vessels
+    with an MMSI in this range (inclusive); a duplicate has its original's MMSI, so the
+    vessels may be read in parts."""
     dataset = dataset_dir if isinstance(dataset_dir, Dataset) else Dataset.open(dataset_dir)
     wanted = list(CANONICAL_COLUMNS if columns is None else columns)
     read = scan_columns(wanted, query) if dataset.duplicate_free else CANONICAL_COLUMNS
     expression = position_filter(query, utc_ms(start), utc_ms(end))
+    if mmsis is not None:
+        expression &= (ds.field("mmsi") >= mmsis[0]) & (ds.field("mmsi") <= mmsis[1])
     tables = [
         table.filter(pa.array(rows_in_query(table, query)))
         for table in dataset.scan(expression, read)

@@ -26,6 +26,7 @@ from __future__ import annotations
 import dataclasses
 import types
 import typing
+from collections.abc import Sequence
 from enum import Enum
 from pathlib import Path
 from typing import Any
@@ -88,7 +89,8 @@ def _fields(table: pd.DataFrame) -> _Fields:
             fields.tz_offsets[str(name)] = np.full(len(column), GDAL_UTC)
             mask = None  # NaT is written as null
         else:
-            values = np.asarray([None if pd.isna(v) else str(v) for v in column], dtype=object)
+            values = column.astype(str).to_numpy(dtype=object)
+            values[missing] = None
             mask = None
         fields.values.append(values)
         fields.names.append(str(name))
@@ -111,7 +113,7 @@ def _dtype(annotation: Any) -> str:
     return "object"
 
 
-def _encounter_table(outcomes: tuple[EncounterOutcome, ...]) -> pd.DataFrame:
+def _encounter_table(outcomes: Sequence[EncounterOutcome]) -> pd.DataFrame:
     """encounters.csv's rows with their values' types (enums as their text)."""
     records = [
         {
@@ -137,14 +139,15 @@ def _action_before_cpa_s(summary: EncounterSummary, mmsi: int) -> float:
     return float(value) if value else float("nan")
 
 
-def write_replay_geopackage(path: Path, result: ReplayResult, chart: Chart | None) -> Path | None:
-    """Write ``report.gpkg`` (see the module docstring). Returns None when there is nothing
-    to map."""
-    outcomes = result.encounters
-    if not outcomes:
-        return None
-    frame = result.frame
-    layers: dict[str, tuple[np.ndarray, pd.DataFrame]] = {}
+# A layer's geometries (WKB in WGS84) and its attribute rows, one per geometry.
+Layer = tuple[np.ndarray, pd.DataFrame]
+
+
+def encounter_layers(outcomes: Sequence[EncounterOutcome], frame: LocalFrame) -> dict[str, Layer]:
+    """The layers drawn from the encounters themselves (all but ``navigable_water``), for
+    ``outcomes`` (at least one) in their order; ``frame``: the run's. Layers of consecutive
+    parts of the encounters, joined in order (``join_layers``), are the layers of the whole:
+    every column's type is fixed, whatever values a part holds."""
     points: list[Any] = []
     tracks: list[Any] = []
     cpa: list[Any] = []
@@ -192,9 +195,6 @@ def write_replay_geopackage(path: Path, result: ReplayResult, chart: Chart | Non
     point_rows = point_rows.assign(
         action_before_cpa_s=actions, vessel=["own", "target"] * len(outcomes)
     )
-    layers["encounters"] = (np.asarray(points, dtype=object), point_rows)
-    layers["tracks"] = (np.asarray(tracks, dtype=object), pd.DataFrame(track_rows))
-    layers["cpa"] = (np.asarray(cpa, dtype=object), pd.DataFrame(cpa_rows))
     domains: list[Any] = []
     domain_rows: list[pd.DataFrame] = []
     for outcome in outcomes:
@@ -218,7 +218,43 @@ def write_replay_geopackage(path: Path, result: ReplayResult, chart: Chart | Non
                 }
             )
         )
-    layers["domains"] = (_to_wgs84(frame, domains), pd.concat(domain_rows, ignore_index=True))
+    return {
+        "encounters": (np.asarray(points, dtype=object), point_rows),
+        "tracks": (
+            np.asarray(tracks, dtype=object),
+            pd.DataFrame(track_rows, columns=["encounter_id", "vessel", "mmsi"]),
+        ),
+        "cpa": (np.asarray(cpa, dtype=object), pd.DataFrame(cpa_rows).astype({"tcpa_s": float})),
+        "domains": (_to_wgs84(frame, domains), pd.concat(domain_rows, ignore_index=True)),
+    }
+
+
+def join_layers(parts: Sequence[dict[str, Layer]]) -> dict[str, Layer]:
+    """The layers of consecutive parts of the encounters, in order."""
+    joined: dict[str, Layer] = {}
+    for name in parts[0]:
+        filled = [part[name] for part in parts if len(part[name][0])] or [parts[0][name]]
+        joined[name] = (
+            np.concatenate([wkb for wkb, _ in filled]),
+            pd.concat([table for _, table in filled], ignore_index=True),
+        )
+    return joined
+
+
+def write_replay_geopackage(
+    path: Path,
+    result: ReplayResult,
+    chart: Chart | None,
+    parts: Sequence[dict[str, Layer]] | None = None,
+) -> Path | None:
+    """Write ``report.gpkg`` (see the module docstring). Returns None when there is nothing
+    to map. ``parts``: ``encounter_layers`` of consecutive parts of ``result.encounters``,
+    made where those are (default: made here)."""
+    outcomes = result.encounters
+    if not outcomes:
+        return None
+    frame = result.frame
+    layers = join_layers(parts) if parts else encounter_layers(outcomes, frame)
     if chart is not None:
         draughts = sorted({o.summary.target_draught_m for o in outcomes})
         ukc_m = result.params.manoeuvrability.ukc_m

@@ -8,12 +8,13 @@ Every file is written atomically. The verdicts and time series come from
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from collections.abc import Callable, Sequence
 from datetime import datetime
 from enum import Enum
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 import matplotlib
 
@@ -44,7 +45,7 @@ from .chart_plot import (
     show_view,
 )
 from .html_report import HTML_NAME, replay_html
-from .replay_geopackage import GEOPACKAGE_NAME, write_replay_geopackage
+from .replay_geopackage import GEOPACKAGE_NAME, encounter_layers, write_replay_geopackage
 
 if TYPE_CHECKING:
     from ..chart import Chart
@@ -545,18 +546,64 @@ def draw_here(
         progress.advance()
 
 
+Part = TypeVar("Part")
+
+
+class EncounterParts(Protocol):
+    """The run's encounters in consecutive parts, each where it is: all of them here
+    (``EncountersHere``), or a slab's on the worker that holds its result
+    (``dask_run.EncountersOnCluster``), so that the per-encounter files are made there."""
+
+    def map(
+        self, function: Callable[[tuple[EncounterOutcome, ...]], Part]
+    ) -> list[Callable[[], Part]]:
+        """Start ``function`` on each part's encounters, in order; the returned callables
+        wait for the parts' results."""
+
+
+@dataclasses.dataclass(frozen=True)
+class EncountersHere:
+    """All the encounters, as one part, in this process."""
+
+    encounters: tuple[EncounterOutcome, ...]
+
+    def map(
+        self, function: Callable[[tuple[EncounterOutcome, ...]], Part]
+    ) -> list[Callable[[], Part]]:
+        result = function(self.encounters)
+        return [lambda: result]
+
+
+def write_series(outcomes: tuple[EncounterOutcome, ...], series_dir: Path) -> int:
+    """Each encounter's time series to its CSV in ``series_dir``; gives how many."""
+    for outcome in outcomes:
+        target = series_dir / f"{outcome.summary.encounter_id}.csv"
+        write_csv(target, _lowercase_booleans(outcome.series))
+    return len(outcomes)
+
+
 def write_replay_reports(
     result: ReplayResult,
     chart: Chart | None,
     plots: bool,
     progress: ProgressSink,
     drawer: Drawer = draw_here,
+    parts: EncounterParts | None = None,
 ) -> tuple[Path, ...]:
     """Write every report file into ``result.out_dir``, which is replaced whole (no file of
     an earlier run stays); returns the paths written. ``drawer`` draws the figures (here, or
-    on the workers of a cluster: ``dask_run.dask_drawer``)."""
+    on the workers of a cluster: ``dask_run.dask_drawer``); ``parts``: where the encounters'
+    series CSVs and map layers are made (default: here)."""
     with report_directory(result.out_dir) as staging:
-        written = _write_replay_files(result, staging, chart, plots, progress, drawer)
+        written = _write_replay_files(
+            result,
+            staging,
+            chart,
+            plots,
+            progress,
+            drawer,
+            parts if parts is not None else EncountersHere(result.encounters),
+        )
     return tuple(result.out_dir / path.relative_to(staging) for path in written)
 
 
@@ -567,37 +614,44 @@ def _write_replay_files(
     plots: bool,
     progress: ProgressSink,
     drawer: Drawer,
+    parts: EncounterParts,
 ) -> tuple[Path, ...]:
     series_dir = out_dir / ENCOUNTER_DIR
+    outcomes = result.encounters
+    series_written = parts.map(functools.partial(write_series, series_dir=series_dir))
+    layers = parts.map(functools.partial(encounter_layers, frame=result.frame)) if outcomes else []
     files: list[Path] = []
     figures: list[tuple[EncounterOutcome, Path]] = []
-    for outcome in result.encounters:
+    for outcome in outcomes:
         target = series_dir / f"{outcome.summary.encounter_id}.csv"
-        write_csv(target, _lowercase_booleans(outcome.series))
         files.append(target)
         if plots:
-            png = series_dir / f"{outcome.summary.encounter_id}.png"
+            png = target.with_suffix(".png")
             figures.append((outcome, png))
             files.append(png)
-        else:
-            progress.advance()
     if figures:
         drawer(figures, chart, result.params.manoeuvrability.ukc_m, result.frame, progress)
+    # The tables and the page while the parts are made; the GeoPackage waits for them.
     encounters_csv = out_dir / ENCOUNTERS_NAME
-    write_csv(encounters_csv, _lowercase_booleans(encounters_frame(result.encounters)))
-    geopackage = write_replay_geopackage(out_dir / GEOPACKAGE_NAME, result, chart)
-    if geopackage is not None:
-        files.append(geopackage)
+    write_csv(encounters_csv, _lowercase_booleans(encounters_frame(outcomes)))
     pairs_csv = out_dir / PAIRS_NAME
     write_csv(pairs_csv, _lowercase_booleans(pairs_frame(result.pairs)))
     index = out_dir / INDEX_NAME
     write_text(index, format_index(result, plots))
     manifest = out_dir / MANIFEST_NAME
     write_json(manifest, result.manifest)
+    geopackage = out_dir / GEOPACKAGE_NAME if outcomes else None
     # The page links only the files written (no report.gpkg without encounters).
     linked = [pairs_csv, encounters_csv, *([geopackage] if geopackage else []), index, manifest]
     page = out_dir / HTML_NAME
     write_text(
         page, replay_html(result, chart, plots, ENCOUNTER_DIR, [path.name for path in linked])
     )
+    if geopackage is not None:
+        write_replay_geopackage(geopackage, result, chart, [wait() for wait in layers])
+        files.append(geopackage)
+    for wait in series_written:
+        written = wait()
+        if not plots:
+            progress.advance(written)
     return (pairs_csv, encounters_csv, *files, index, page, manifest)
