@@ -618,8 +618,9 @@ def _write_replay_files(
 ) -> tuple[Path, ...]:
     series_dir = out_dir / ENCOUNTER_DIR
     outcomes = result.encounters
-    series_written = parts.map(functools.partial(write_series, series_dir=series_dir))
+    # The map layers first: the GeoPackage, written here, waits for them.
     layers = parts.map(functools.partial(encounter_layers, frame=result.frame)) if outcomes else []
+    series_written = parts.map(functools.partial(write_series, series_dir=series_dir))
     files: list[Path] = []
     figures: list[tuple[EncounterOutcome, Path]] = []
     for outcome in outcomes:
