@@ -15,6 +15,7 @@ spilled reports): give ``--scratch`` on a file system they all mount.
 from __future__ import annotations
 
 import logging
+import multiprocessing
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import ExitStack, closing, contextmanager
@@ -56,8 +57,21 @@ def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
         return
     # Dask's nannies set MALLOC_TRIM_THRESHOLD_=65536 in their workers, so that freed memory
     # goes back to the system at once; on a slab's arrays that makes every task 1.7x slower.
-    # A slab's memory is bounded anyway: keep glibc's own threshold.
-    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+    # A slab's memory is bounded anyway: keep glibc's own threshold. A worker's event loop
+    # shares the GIL with its task: Dask's profiler samples the task's stack every 10 ms
+    # (for a dashboard this cluster has not), and the loop wakes every 20 ms to time itself
+    # and every 100 ms to measure the memory. A slab runs for seconds: check once a second.
+    # The workers are forked from a server that imported NumPy, pandas and the like once,
+    # rather than each importing them anew while the input is read beside them.
+    settings: dict[str, object] = {
+        "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+        "distributed.worker.profile.enabled": False,
+        "distributed.admin.tick.interval": "1s",
+        "distributed.worker.memory.monitor-interval": "1s",
+    }
+    if "forkserver" in multiprocessing.get_all_start_methods():
+        settings["distributed.worker.multiprocessing-method"] = "forkserver"
+    with dask.config.set(settings):
         cluster = LocalCluster(
             n_workers=workers,
             threads_per_worker=1,
