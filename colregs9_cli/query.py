@@ -20,6 +20,7 @@ error that names the file and the key.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import re
@@ -268,6 +269,13 @@ class Query:
     tables: Mapping[str, Mapping[str, Any]] = field(default_factory=lambda: MappingProxyType({}))
     source: Path | None = None
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # The tables are read-only views, which pickle cannot copy; a query is sent to Dask
+        # workers: its tables travel as dicts and are made read-only again.
+        state = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        state["tables"] = {key: dict(table) for key, table in self.tables.items()}
+        return (_unpickled_query, (state,))
+
     def frame(self) -> LocalFrame | None:
         """The run's local metric frame, centred on the region's box; None without a region."""
         # pyproj is imported here, by the commands that project, not by every read.
@@ -277,6 +285,14 @@ class Query:
             return None
         r = self.region
         return LocalFrame.centred_on(r.lat_min, r.lat_max, r.lon_min, r.lon_max)
+
+
+def _unpickled_query(state: dict[str, Any]) -> Query:
+    tables = state.pop("tables")
+    return Query(
+        **state,
+        tables=MappingProxyType({key: MappingProxyType(table) for key, table in tables.items()}),
+    )
 
 
 def everything_query() -> Query:

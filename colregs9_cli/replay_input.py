@@ -144,11 +144,8 @@ class ReplayInput:
         ranges = _mmsi_ranges(self.dataset, self.query, number)
         if len(ranges) < 2:
             return (self,)
-        # The query's parameter tables cannot be pickled, and reading does not use them.
-        query = dataclasses.replace(self.query, tables={})
         return tuple(
-            dataclasses.replace(self, query=query, mmsis=mmsis, counts=ReadCounts())
-            for mmsis in ranges
+            dataclasses.replace(self, mmsis=mmsis, counts=ReadCounts()) for mmsis in ranges
         )
 
     def merge(self, parts: Sequence[SegmentedInputPart]) -> Segmentation:

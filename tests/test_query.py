@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import pickle
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -79,6 +80,12 @@ cpa_req_m = 150.0
     )
     assert selected.tolist() == [True, False, False, False]
     assert query.source == path
+    # A query goes to Dask workers whole, its stage tables read-only again there.
+    copy = pickle.loads(pickle.dumps(query))
+    assert copy == query
+    assert copy.tables["replay"]["cpa_req_m"] == 150.0
+    with pytest.raises(TypeError):
+        copy.tables["replay"]["cpa_req_m"] = 1.0  # type: ignore[index]
 
 
 def test_start_must_precede_end(tmp_path: Path) -> None:
