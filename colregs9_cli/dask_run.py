@@ -196,7 +196,9 @@ def dask_segments(
     with its arguments bound) as one task, ``bar`` advanced as each ends; the results in the
     order of ``parts``, whatever the order they end in."""
     futures = [client.submit(part, pure=False) for part in parts]
+    order = {future.key: index for index, future in enumerate(futures)}
+    results: dict[int, Part] = {}
     for future in as_completed(futures, loop=client.loop):
-        future.result()
+        results[order[future.key]] = future.result()
         bar.advance()
-    return [future.result() for future in futures]
+    return [results[index] for index in range(len(futures))]

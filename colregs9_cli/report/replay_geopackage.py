@@ -246,13 +246,11 @@ def write_replay_geopackage(
     result: ReplayResult,
     chart: Chart | None,
     parts: Sequence[dict[str, Layer]] | None = None,
-) -> Path | None:
-    """Write ``report.gpkg`` (see the module docstring). Returns None when there is nothing
-    to map. ``parts``: ``encounter_layers`` of consecutive parts of ``result.encounters``,
-    made where those are (default: made here)."""
+) -> None:
+    """Write ``report.gpkg`` (see the module docstring) of a result with at least one
+    encounter (without, the report has no GeoPackage). ``parts``: ``encounter_layers`` of
+    consecutive parts of ``result.encounters``, made where those are (default: made here)."""
     outcomes = result.encounters
-    if not outcomes:
-        return None
     frame = result.frame
     layers = join_layers(parts) if parts else encounter_layers(outcomes, frame)
     if chart is not None:
@@ -286,7 +284,6 @@ def write_replay_geopackage(
             )
             written += 1
         add_layer_styles(tmp, [name for name, (wkb, _) in layers.items() if len(wkb)])
-    return path
 
 
 def _geometry_type(layer: str) -> str:

@@ -574,11 +574,15 @@ class EncountersHere:
         return [lambda: result]
 
 
+def series_path(series_dir: Path, outcome: EncounterOutcome) -> Path:
+    """Where an encounter's time series is written (its figure: the same name, ``.png``)."""
+    return series_dir / f"{outcome.summary.encounter_id}.csv"
+
+
 def write_series(outcomes: tuple[EncounterOutcome, ...], series_dir: Path) -> int:
     """Each encounter's time series to its CSV in ``series_dir``; gives how many."""
     for outcome in outcomes:
-        target = series_dir / f"{outcome.summary.encounter_id}.csv"
-        write_csv(target, _lowercase_booleans(outcome.series))
+        write_csv(series_path(series_dir, outcome), _lowercase_booleans(outcome.series))
     return len(outcomes)
 
 
@@ -624,7 +628,7 @@ def _write_replay_files(
     files: list[Path] = []
     figures: list[tuple[EncounterOutcome, Path]] = []
     for outcome in outcomes:
-        target = series_dir / f"{outcome.summary.encounter_id}.csv"
+        target = series_path(series_dir, outcome)
         files.append(target)
         if plots:
             png = target.with_suffix(".png")
