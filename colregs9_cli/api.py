@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from .ais.load import load_ais
+from .ais.load import count_ais, load_ais
 from .dimensions import GroupBy, Per, dimension_stats
 from .errors import ParameterError
 from .query import everything_query, load_query
@@ -49,9 +49,9 @@ def vessel_stats(
             f"{exc}; per is one of {[p.value for p in Per]}, by one of "
             f"{[b.value for b in GroupBy]} or None"
         ) from None
-    data = load_ais([Path(p) for p in paths], query=selected, needs_time=False)
+    data = count_ais([Path(p) for p in paths], query=selected)
     return dimension_stats(
-        data.positions, data.dimension_reports, per=per_choice, by=by_choice
+        data.position_counts, data.dimension_reports, per=per_choice, by=by_choice
     ).to_frame()
 
 

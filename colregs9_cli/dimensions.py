@@ -9,6 +9,12 @@ distinct report weighted by how often it was sent (the median of the expanded li
 reports, the mean of the two middle reports when their number is even). Per message, every
 position row in the query that carries a value counts once.
 
+The positions come as counts (``POSITION_COUNT_COLUMNS``): each row stands for
+``n_positions`` position messages with its MMSI, ship type and dimensions. A reader can so
+count the positions as it scans them (``ais.load.count_ais``) rather than hold them, and
+the statistics per message are those of the messages the rows stand for, whatever the
+rows: a frame of positions with ``n_positions`` 1 gives the same statistics as its counts.
+
 The sample standard deviation (ddof = 1) is undefined for fewer than two values; it is then
 NaN in the tables, an empty cell in the CSV and ``null`` in ``run.json``. The same holds for
 every statistic of a dimension with no value at all.
@@ -27,6 +33,8 @@ import pandas as pd
 DIMENSIONS: tuple[str, ...] = ("length_m", "breadth_m", "draught_m")
 # The columns of the positions ``dimension_stats`` uses: a dataset is read for these alone.
 POSITION_COLUMNS: tuple[str, ...] = ("mmsi", "ship_type", *DIMENSIONS)
+# The positions as ``dimension_stats`` takes them: how many messages each row stands for.
+POSITION_COUNT_COLUMNS: tuple[str, ...] = (*POSITION_COLUMNS, "n_positions")
 STAT_COLUMNS: tuple[str, ...] = ("count", "mean", "median", "std", "min", "max")
 # Vessels whose ship type is never reported are grouped under this label with ``--by``.
 NO_SHIP_TYPE = "Unknown"
@@ -97,8 +105,9 @@ class StatsTable:
 class StatsResult:
     """Dimension statistics per vessel or per message, overall and optionally per ship type.
 
-    ``samples`` holds the counted units, one row each (a vessel or a position message), with
-    ``mmsi``, ``ship_type`` and the three dimensions; the histograms are drawn from it.
+    ``samples`` holds the counted units, with ``mmsi``, ``ship_type``, the three dimensions
+    and ``units``, how many units the row stands for: one vessel, or ``n_positions`` position
+    messages; the histograms are drawn from it.
     """
 
     per: Per
@@ -145,7 +154,11 @@ def weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
     if values.size == 0:
         return math.nan
     order = np.argsort(values, kind="stable")
-    values, cumulative = values[order], np.cumsum(weights[order])
+    return _sorted_median(values[order], np.cumsum(weights[order]))
+
+
+def _sorted_median(values: np.ndarray, cumulative: np.ndarray) -> float:
+    """The weighted median of sorted ``values`` given their running weights."""
     total = int(cumulative[-1])
     lower = values[np.searchsorted(cumulative, (total - 1) // 2, side="right")]
     upper = values[np.searchsorted(cumulative, total // 2, side="right")]
@@ -176,58 +189,75 @@ def vessel_medians(dimension_reports: pd.DataFrame) -> pd.DataFrame:
     return result
 
 
-def vessel_ship_types(positions: pd.DataFrame) -> pd.Series:
-    """Each vessel's most frequent non-null ship type (ties: alphabetically first)."""
-    mmsis = pd.Index(np.unique(positions["mmsi"]), name="mmsi")
-    typed = positions.loc[positions["ship_type"].notna(), ["mmsi", "ship_type"]]
-    counts = typed.groupby(["mmsi", "ship_type"]).size().rename("n").reset_index()
+def vessel_ship_types(position_counts: pd.DataFrame) -> pd.Series:
+    """Each vessel's most frequent non-null ship type over its position messages (ties:
+    alphabetically first)."""
+    mmsis = pd.Index(np.unique(position_counts["mmsi"]), name="mmsi")
+    typed = position_counts.loc[
+        position_counts["ship_type"].notna(), ["mmsi", "ship_type", "n_positions"]
+    ]
+    counts = typed.groupby(["mmsi", "ship_type"])["n_positions"].sum().rename("n").reset_index()
     counts = counts.sort_values(["mmsi", "n", "ship_type"], ascending=[True, False, True])
     most_frequent = counts.drop_duplicates("mmsi").set_index("mmsi")["ship_type"]
-    return most_frequent.reindex(mmsis).fillna(NO_SHIP_TYPE).astype(str)
+    # object first: with no type reported at all, the empty series would be float
+    return most_frequent.astype(object).reindex(mmsis).fillna(NO_SHIP_TYPE).astype(str)
 
 
 def summarise(samples: pd.DataFrame, group: str | None = None) -> StatsTable:
-    """The statistics of each dimension over the rows of ``samples`` (one row per unit)."""
+    """The statistics of each dimension over the units of ``samples``, each row standing for
+    ``units`` of them: those of the list of values with each row's repeated ``units`` times."""
+    units = samples["units"].to_numpy(dtype=np.int64)
     rows = []
     for dimension in DIMENSIONS:
+        values = samples[dimension].to_numpy(dtype=float)
+        valid = ~np.isnan(values) & (units > 0)
         # Sorted, so that the sums (mean, std) do not depend on the order of the rows.
-        values = np.sort(samples[dimension].dropna().to_numpy(dtype=float))
-        count = int(values.size)
+        order = np.argsort(values[valid], kind="stable")
+        values, weights = values[valid][order], units[valid][order]
+        count = int(weights.sum())
+        mean = float(np.sum(values * weights) / count) if count else math.nan
         rows.append(
             DimensionStats(
                 dimension=dimension,
                 count=count,
-                missing=len(samples) - count,
-                mean=float(values.mean()) if count else math.nan,
-                median=float(np.median(values)) if count else math.nan,
-                std=float(values.std(ddof=1)) if count >= 2 else math.nan,
-                min=float(values.min()) if count else math.nan,
-                max=float(values.max()) if count else math.nan,
+                missing=int(units.sum()) - count,
+                mean=mean,
+                median=_sorted_median(values, np.cumsum(weights)) if count else math.nan,
+                std=(
+                    math.sqrt(float(np.sum(weights * (values - mean) ** 2)) / (count - 1))
+                    if count >= 2
+                    else math.nan
+                ),
+                min=float(values[0]) if count else math.nan,
+                max=float(values[-1]) if count else math.nan,
             )
         )
-    return StatsTable(group=group, units=len(samples), rows=tuple(rows))
+    return StatsTable(group=group, units=int(units.sum()), rows=tuple(rows))
 
 
 def dimension_stats(
-    positions: pd.DataFrame,
+    position_counts: pd.DataFrame,
     dimension_reports: pd.DataFrame,
     per: Per = Per.VESSEL,
     by: GroupBy | None = None,
 ) -> StatsResult:
-    """Dimension statistics over the vessels (or position messages) in ``positions``.
+    """Dimension statistics over the vessels (or position messages) of ``position_counts``.
 
-    ``positions``: the canonical position rows selected by the query. ``dimension_reports``:
-    ``mmsi, length_m, breadth_m, draught_m, n_reports``, the distinct reported combinations
-    over the whole input with how often each was sent (used per vessel only).
+    ``position_counts``: ``POSITION_COUNT_COLUMNS``, the position rows selected by the query,
+    each row standing for ``n_positions`` of them (see the module docstring).
+    ``dimension_reports``: ``mmsi, length_m, breadth_m, draught_m, n_reports``, the distinct
+    reported combinations over the whole input with how often each was sent (used per vessel
+    only).
     """
-    ship_types = vessel_ship_types(positions)
+    ship_types = vessel_ship_types(position_counts)
     if per is Per.VESSEL:
         medians = vessel_medians(dimension_reports).reindex(ship_types.index)
-        samples = medians.assign(ship_type=ship_types).reset_index()
+        samples = medians.assign(ship_type=ship_types, units=1).reset_index()
     else:
-        samples = positions[["mmsi", *DIMENSIONS]].reset_index(drop=True)
+        samples = position_counts[["mmsi", *DIMENSIONS]].reset_index(drop=True)
         samples["ship_type"] = samples["mmsi"].map(ship_types)
-    samples = samples[["mmsi", "ship_type", *DIMENSIONS]]
+        samples["units"] = position_counts["n_positions"].to_numpy(dtype=np.int64)
+    samples = samples[["mmsi", "ship_type", *DIMENSIONS, "units"]]
     groups: tuple[StatsTable, ...] = ()
     if by is GroupBy.SHIP_TYPE:
         groups = tuple(
@@ -240,6 +270,6 @@ def dimension_stats(
         overall=summarise(samples),
         groups=groups,
         vessels=len(ship_types),
-        messages=len(positions),
+        messages=int(position_counts["n_positions"].sum()),
         samples=samples,
     )

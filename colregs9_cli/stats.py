@@ -70,23 +70,14 @@ def run_stats(
 
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
         check_out_dir(target, overwrite)
-        from .ais.load import load_ais
-        from .dimensions import POSITION_COLUMNS, GroupBy, Per, dimension_stats
+        from .ais.load import count_ais
+        from .dimensions import GroupBy, Per, dimension_stats
         from .report.stats_report import build_manifest, format_text, write_stats_reports
 
         per = _choice(Per, per, "--per")
         by = None if by is None else _choice(GroupBy, by, "--by")
-        data = load_ais(
-            paths,
-            query=query,
-            fmt=fmt,
-            quiet=quiet,
-            started=started,
-            columns=POSITION_COLUMNS,
-            ordered=False,
-            needs_time=False,
-        )
-    result = dimension_stats(data.positions, data.dimension_reports, per=per, by=by)
+        data = count_ais(paths, query=query, fmt=fmt, quiet=quiet, started=started)
+    result = dimension_stats(data.position_counts, data.dimension_reports, per=per, by=by)
     manifest = build_manifest(result, query, data)
     files = write_stats_reports(target, result, query.name, manifest)
     return StatsRun(

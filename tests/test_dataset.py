@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import gzip
 import json
+import re
 import warnings
 from datetime import UTC, datetime
 from pathlib import Path
@@ -16,6 +17,7 @@ import pyarrow.parquet as pq
 import pytest
 from typer.testing import CliRunner
 
+from colregs9_cli.ais import load as load_module
 from colregs9_cli.ais.dataset import (
     dataset_time_range,
     ingest,
@@ -23,10 +25,11 @@ from colregs9_cli.ais.dataset import (
     read_dataset_window,
 )
 from colregs9_cli.ais.dataset_scan import MANIFEST_NAME, Dataset, position_filter
-from colregs9_cli.ais.load import AisData, load_ais
+from colregs9_cli.ais.load import AisData, count_ais, load_ais
 from colregs9_cli.ais.schema import CANONICAL_SCHEMA
 from colregs9_cli.cli import app
-from colregs9_cli.errors import InputFileError
+from colregs9_cli.dimensions import POSITION_COLUMNS
+from colregs9_cli.errors import InputFileError, NoDataError
 from colregs9_cli.query import Query, Region, TimeWindow, VesselFilter, load_query
 
 from fixture_files import DMA22, DMA26, NMEA, ROOT
@@ -218,6 +221,58 @@ def test_stats_over_the_dataset_equals_stats_over_the_files(
         assert result.exit_code == 0, result.output
         outputs.append((result.stdout, (out / "dimension_stats.csv").read_text()))
     assert outputs[0] == outputs[1]
+
+
+def _counted_by_pandas(data: AisData) -> pd.DataFrame:
+    """The positions counted by their MMSI, ship type and dimensions, with pandas."""
+    keys = list(POSITION_COLUMNS)
+    counts = data.positions[keys].groupby(keys, dropna=False).size()
+    return counts.rename("n_positions").reset_index()
+
+
+@pytest.fixture(scope="module")
+def nmea_dataset(tmp_path_factory: pytest.TempPathFactory, nmea: Path) -> Path:
+    """The NMEA excerpt alone, in small row groups: a dataset without duplicates."""
+    out = tmp_path_factory.mktemp("nmea_dataset") / "ais"
+    ingest([nmea], out, row_group_rows=500)
+    return out
+
+
+@pytest.mark.parametrize("chunk_rows", [700, 1 << 20])
+@pytest.mark.parametrize("name", ["everything", *QUERIES])
+def test_a_dataset_is_counted_as_it_is_scanned(
+    nmea_dataset: Path, nmea: Path, name: str, chunk_rows: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Counted in chunks of any size, the positions of a dataset read alone are those of the
+    file, counted; the reports and the ledger are the file's too."""
+    assert Dataset.open(nmea_dataset).duplicate_free  # so no position row is held
+    monkeypatch.setattr(load_module, "_COUNT_CHUNK_ROWS", chunk_rows)
+    query = QUERIES.get(name)
+    try:
+        want = load_ais([nmea], query)
+    except NoDataError as error:  # the query 'mmsi' selects none of the excerpt's vessels
+        with pytest.raises(NoDataError, match=re.escape(str(error))):
+            count_ais([nmea_dataset], query)
+        return
+    got = count_ais([nmea_dataset], query)
+    pd.testing.assert_frame_equal(got.position_counts, _counted_by_pandas(want))
+    pd.testing.assert_frame_equal(got.dimension_reports, want.dimension_reports)
+    assert got.ledger.to_dict() == want.ledger.to_dict()
+    assert got.rows_in_query == want.rows_in_query == got.position_counts["n_positions"].sum()
+    assert [i.sha256 for i in got.inputs] == [i.sha256 for i in want.inputs]
+
+
+@pytest.mark.parametrize("inputs", ["files", "dataset"])
+def test_files_are_counted_after_the_load(
+    dataset: Path, files: list[Path], from_files: AisData, inputs: str
+) -> None:
+    """Files (in which duplicates are sought across inputs) are loaded, then counted; a
+    dataset of the same files is counted as it is scanned: the same counts."""
+    got = count_ais(files if inputs == "files" else [dataset])
+    pd.testing.assert_frame_equal(got.position_counts, _counted_by_pandas(from_files))
+    pd.testing.assert_frame_equal(got.dimension_reports, from_files.dimension_reports)
+    assert got.ledger.to_dict() == from_files.ledger.to_dict()
+    assert got.rows_in_query == from_files.rows_in_query
 
 
 def _corrupt_skipped_row_groups(directory: Path, query: Query) -> int:

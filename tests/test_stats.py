@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -21,8 +22,10 @@ from colregs9_cli.dimensions import (
     weighted_median,
 )
 from colregs9_cli.report.stats_report import (
+    HISTOGRAM_MAX_BINS,
     format_markdown,
     format_text,
+    histogram_bins,
     histogram_figure,
     write_stats_reports,
 )
@@ -70,7 +73,7 @@ POSITIONS = pd.DataFrame(
         (F, None, NAN, NAN, NAN),
     ],
     columns=["mmsi", "ship_type", "length_m", "breadth_m", "draught_m"],
-)
+).assign(n_positions=1)
 
 
 def _check(row, count, missing, mean, median, std, low, high) -> None:  # type: ignore[no-untyped-def]
@@ -136,7 +139,9 @@ def test_vessel_medians_by_hand() -> None:
 def test_ship_type_is_the_most_frequent_one() -> None:
     types = vessel_ship_types(POSITIONS)
     assert types.to_dict() == {A: "Cargo", B: "Cargo", C: "Fishing", D: "Pilot", F: "Unknown"}
-    tie = pd.DataFrame({"mmsi": [A, A, A], "ship_type": ["Tug", "Pilot", None]})
+    tie = pd.DataFrame(
+        {"mmsi": [A, A, A], "ship_type": ["Tug", "Pilot", None], "n_positions": [1, 1, 1]}
+    )
     assert vessel_ship_types(tie).loc[A] == "Pilot"  # a tie goes to the first alphabetically
 
 
@@ -275,3 +280,118 @@ def test_histograms_plot_every_counted_value() -> None:
         lefts = [bar.get_x() for bar in bars]
         assert min(lefts) == pytest.approx(result.overall.row(dimension).min)
     figure.canvas.draw()  # smoke render
+
+
+# Position messages: (vessel, ship type, length in dm or none, how many such rows).
+MESSAGES = st.lists(
+    st.tuples(
+        st.integers(0, 4),
+        st.sampled_from(["Cargo", "Tanker", None]),
+        st.one_of(st.none(), st.integers(50, 3000)),
+        st.integers(1, 4),
+    ),
+    min_size=1,
+    max_size=30,
+)
+
+
+def _messages_frame(messages: list[tuple[int, str | None, int | None, int]]) -> pd.DataFrame:
+    """One row per message: each drawn row repeated its count of times."""
+    rows = [
+        (201000000 + vessel, ship_type, NAN if length is None else length / 10, 5.0, NAN)
+        for vessel, ship_type, length, times in messages
+        for _ in range(times)
+    ]
+    frame = pd.DataFrame(rows, columns=["mmsi", "ship_type", "length_m", "breadth_m", "draught_m"])
+    return frame.assign(n_positions=1)
+
+
+def _reports_of(frame: pd.DataFrame) -> pd.DataFrame:
+    reports = frame.drop(columns=["ship_type", "n_positions"]).dropna(subset=["length_m"])
+    return reports.assign(n_reports=1)
+
+
+@given(MESSAGES, st.sampled_from(list(Per)), st.sampled_from([None, GroupBy.SHIP_TYPE]))
+def test_counted_positions_give_the_statistics_of_their_messages(
+    messages: list[tuple[int, str | None, int | None, int]], per: Per, by: GroupBy | None
+) -> None:
+    """Rows standing for several messages each (``n_positions``) give the statistics of the
+    messages one row each: per vessel and per message, overall and by ship type."""
+    one_each = _messages_frame(messages)
+    keys = ["mmsi", "ship_type", "length_m", "breadth_m", "draught_m"]
+    counted = (
+        one_each.groupby(keys, dropna=False)["n_positions"].sum().reset_index().sample(frac=1.0)
+    )
+    reports = _reports_of(one_each)
+    want = dimension_stats(one_each, reports, per=per, by=by)
+    got = dimension_stats(counted, reports, per=per, by=by)
+    assert (
+        (got.vessels, got.messages)
+        == (want.vessels, want.messages)
+        == (
+            one_each["mmsi"].nunique(),
+            len(one_each),
+        )
+    )
+    for got_table, want_table in zip(
+        (got.overall, *got.groups), (want.overall, *want.groups), strict=True
+    ):
+        assert (got_table.group, got_table.units) == (want_table.group, want_table.units)
+        for got_row, want_row in zip(got_table.rows, want_table.rows, strict=True):
+            assert (got_row.count, got_row.missing) == (want_row.count, want_row.missing)
+            for name in ("mean", "median", "std", "min", "max"):
+                assert getattr(got_row, name) == pytest.approx(
+                    getattr(want_row, name), rel=1e-12, nan_ok=True
+                )
+
+
+@given(st.lists(st.tuples(st.integers(0, 3000), st.integers(1, 50)), min_size=1, max_size=40))
+def test_histogram_bins_count_every_unit(values_and_units: list[tuple[int, int]]) -> None:
+    """A row standing for k units bins as k rows of one unit; one value takes one bin."""
+    frame = pd.DataFrame(values_and_units, columns=["value", "units"]).sort_values("value")
+    values, units = frame["value"].to_numpy(dtype=float) / 10, frame["units"].to_numpy()
+    expanded = np.repeat(values, units)
+    bins = histogram_bins(values, units)
+    assert bins == histogram_bins(expanded, np.ones(expanded.size, dtype=np.int64))
+    assert 1 <= bins <= HISTOGRAM_MAX_BINS
+    if values[0] == values[-1]:
+        assert bins == 1
+    else:  # at least Sturges' count of bins
+        assert bins >= min(HISTOGRAM_MAX_BINS, math.ceil(math.log2(expanded.size) + 1))
+
+
+def test_histogram_bins_by_hand() -> None:
+    # 8 units over 0..7: Sturges gives ceil(log2 8 + 1) = 4; quartiles 1 and 5 (sorted units
+    # 0..7 at places 1 and 5), Freedman-Diaconis width 2 · 4 · 8^(-1/3) = 4, 7/4 -> 2 bins.
+    assert histogram_bins(np.arange(8.0), np.ones(8, dtype=np.int64)) == 4
+    # 1,000 units at 0 and 1,000 at 10: the quartiles 0 and 10 make FD 10 / (20 / 2000^(1/3))
+    # = 6.3 -> 7 bins, below Sturges' ceil(log2 2000 + 1) = 12.
+    assert histogram_bins(np.array([0.0, 10.0]), np.array([1000, 1000])) == 12
+    # Many units spread evenly: FD asks for more than the cap.
+    assert histogram_bins(np.arange(2000.0), np.full(2000, 100)) == HISTOGRAM_MAX_BINS
+
+
+def test_histograms_weigh_each_row_by_its_units() -> None:
+    counted = POSITIONS.assign(n_positions=[1, 2, 3, 1, 1, 1, 1, 1, 1])
+    result = dimension_stats(counted, DIMENSION_REPORTS, per=Per.MESSAGE, by=GroupBy.SHIP_TYPE)
+    assert result.messages == 12
+    figure = histogram_figure(result, "counted")
+    for axis, dimension in zip(figure.axes, ("length_m", "breadth_m", "draught_m"), strict=True):
+        bars = [p for p in axis.patches if isinstance(p, Rectangle)]
+        # stacked: each type's bars stand on the others'; the top of each column is the total
+        tops: dict[float, float] = {}
+        for bar in bars:
+            tops[bar.get_x()] = max(tops.get(bar.get_x(), 0.0), bar.get_y() + bar.get_height())
+        assert sum(tops.values()) == result.overall.row(dimension).count
+        assert axis.get_title() == f"{axis.get_xlabel()}: n = {result.overall.row(dimension).count}"
+    figure.canvas.draw()  # smoke render
+
+
+def test_no_ship_type_at_all_is_unknown_without_a_warning() -> None:
+    untyped = POSITIONS.assign(ship_type=None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        types = vessel_ship_types(untyped)
+        result = dimension_stats(untyped, DIMENSION_REPORTS, by=GroupBy.SHIP_TYPE)
+    assert set(types) == {"Unknown"}
+    assert [table.group for table in result.groups] == ["Unknown"]

@@ -50,6 +50,10 @@ whole per file (see nmea.py).
 files (``_read_dataset``): its rows were cleaned at ingest, so only the query is applied,
 pushed down into the scan (dataset_scan.py), and the dimension reports of the vessels in the
 query are counted over the whole dataset, as over a whole file.
+
+``count_ais`` reads as ``load_ais`` does but gives the positions as counts of their MMSI,
+ship type and dimensions, all that the dimension statistics use; a dataset read alone is
+counted as it is scanned, so ``colregs9 stats`` over months of AIS holds no position rows.
 """
 
 from __future__ import annotations
@@ -67,6 +71,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
 
+from ..dimensions import POSITION_COLUMNS
 from ..errors import InputFileError, NoDataError, ParameterError
 from ..progress import ProgressSink, progress_bar, progress_enabled
 from ..query import Query, everything_query
@@ -110,10 +115,12 @@ if TYPE_CHECKING:
 __all__ = [
     "LAYOUTS",
     "AisData",
+    "CountedAis",
     "InputFile",
     "RowSink",
     "StreamedInput",
     "canonical_frame",
+    "count_ais",
     "load_ais",
     "no_positions_error",
     "rows_in_query",
@@ -128,6 +135,8 @@ _EXAMPLE_CHARS = 160
 _DECIMAL = re.compile(r"[-+]?\d+(\.\d*)?")
 # Merge the per-block dimension counts once this many have piled up.
 _DIMENSION_PARTS_BEFORE_MERGE = 64
+# Rows grouped at once when positions or reports are counted (``_Counts``).
+_COUNT_CHUNK_ROWS = 1 << 20
 # Convert the rows set aside once they hold this many bytes (see ``_FileResult.set_aside``).
 _SET_ASIDE_BYTES = 8 * 1024 * 1024
 
@@ -186,14 +195,31 @@ def load_ais(
     query.
     """
     query = query if query is not None else everything_query()
+    wanted = list(CANONICAL_COLUMNS if columns is None else columns)
+    if not set(wanted) <= set(CANONICAL_COLUMNS):
+        raise ParameterError(f"columns {wanted}: give canonical columns ({CANONICAL_COLUMNS})")
+    sources = _open_inputs(paths, query, fmt)
+    return _load(sources, query, fmt, quiet, started, wanted, ordered, needs_time)
+
+
+def _open_inputs(paths: Sequence[Path], query: Query, fmt: str | None) -> list[Source | Dataset]:
     ingest_params(query)
     check_format(fmt)
     if not paths:
         raise InputFileError("no AIS input files given; name at least one file")
-    wanted = list(CANONICAL_COLUMNS if columns is None else columns)
-    if not set(wanted) <= set(CANONICAL_COLUMNS):
-        raise ParameterError(f"columns {wanted}: give canonical columns ({CANONICAL_COLUMNS})")
-    sources = [_open_input(Path(p)) for p in paths]
+    return [_open_input(Path(p)) for p in paths]
+
+
+def _load(
+    sources: Sequence[Source | Dataset],
+    query: Query,
+    fmt: str | None,
+    quiet: bool,
+    started: CsvReading | None,
+    wanted: Sequence[str],
+    ordered: bool,
+    needs_time: bool,
+) -> AisData:
     ledger = RejectsLedger()
     collected = _Collected(may_repeat=not _dataset_alone(sources), ordered=ordered)
     scanned = (
@@ -204,7 +230,10 @@ def load_ais(
     with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet), in_bytes=True) as bar:
         for index, source in enumerate(sources):
             if not isinstance(source, Source):
-                inputs.extend(_read_dataset(source, query, scanned, ledger, collected, bar))
+                inputs.extend(
+                    _read_dataset(source, query, scanned, ledger, collected.kept.append, bar)
+                )
+                collected.datasets.append(source)
                 continue
             part = _read_source(
                 source, fmt, query, bar, started if index == 0 else None, needs_time=needs_time
@@ -215,9 +244,119 @@ def load_ais(
     positions, dimension_reports = collected.finish(ledger)
     if positions.empty:
         raise no_positions_error(inputs, ledger, query)
-    if columns is not None:
-        positions = positions[wanted]
+    if list(positions.columns) != list(wanted):
+        positions = positions[list(wanted)]
     return AisData(positions, dimension_reports, ledger, tuple(inputs), len(positions))
+
+
+@dataclass(frozen=True)
+class CountedAis:
+    """``AisData`` with the positions counted: ``position_counts`` holds
+    ``dimensions.POSITION_COUNT_COLUMNS``, one row per distinct (mmsi, ship type, dimensions) of the
+    positions, sorted, with how many positions have them (``n_positions``)."""
+
+    position_counts: pd.DataFrame
+    dimension_reports: pd.DataFrame
+    ledger: RejectsLedger
+    inputs: tuple[InputFile, ...]
+    rows_in_query: int
+
+
+def count_ais(
+    paths: Sequence[Path],
+    query: Query | None = None,
+    fmt: str | None = None,
+    quiet: bool = True,
+    started: CsvReading | None = None,
+) -> CountedAis:
+    """What ``load_ais(..., needs_time=False)`` reads, with the positions counted by their
+    MMSI, ship type and dimensions (``CountedAis``): what the dimension statistics need.
+
+    One dataset read alone holds no duplicates (``_dataset_alone``): it is counted as it is
+    scanned, in memory set by the vessels, not by the rows. Other inputs are loaded whole, as
+    duplicates across them are found among all their rows, and then counted.
+    """
+    query = query if query is not None else everything_query()
+    sources = _open_inputs(paths, query, fmt)
+    counts = _Counts(POSITION_COLUMNS, "n_positions")
+    if not _dataset_alone(sources):
+        data = _load(sources, query, fmt, quiet, started, POSITION_COLUMNS, False, False)
+        counts.add(pa.Table.from_pandas(data.positions, preserve_index=False))
+        return CountedAis(
+            _counts_frame(counts.finish()),
+            data.dimension_reports,
+            data.ledger,
+            data.inputs,
+            data.rows_in_query,
+        )
+    dataset = sources[0]
+    assert not isinstance(dataset, Source), "_dataset_alone: a dataset"
+    ledger = RejectsLedger()
+    scanned = scan_columns(POSITION_COLUMNS, query, ordered=False)
+    with progress_bar(
+        "Reading AIS", float(dataset.size_bytes), progress_enabled(quiet), in_bytes=True
+    ) as bar:
+        inputs = _read_dataset(dataset, query, scanned, ledger, counts.add, bar)
+    position_counts = _counts_frame(counts.finish())
+    kept = int(position_counts["n_positions"].sum())
+    ledger.use(kept)
+    if kept == 0:
+        raise no_positions_error(inputs, ledger, query)
+    vessels = np.unique(position_counts["mmsi"].to_numpy())
+    reports = _reports_frame(_dataset_reports(dataset, vessels), vessels)
+    return CountedAis(position_counts, reports, ledger, inputs, kept)
+
+
+class _Counts:
+    """How many rows of the tables added have each distinct combination of ``keys``
+    (nulls included), in the column ``name``. Arrow's hash grouping runs over chunks of
+    about ``_COUNT_CHUNK_ROWS`` rows: a grouping costs per call, and a chunk bounds memory."""
+
+    def __init__(self, keys: Sequence[str], name: str) -> None:
+        self.keys, self.name = list(keys), name
+        self._chunk: list[pa.Table] = []
+        self._chunk_rows = 0
+        self._counted: list[pa.Table] = []
+
+    def add(self, table: pa.Table) -> None:
+        self._chunk.append(table.select(self.keys))
+        self._chunk_rows += table.num_rows
+        if self._chunk_rows >= _COUNT_CHUNK_ROWS:
+            self._count_chunk()
+
+    def _count_chunk(self) -> None:
+        if self._chunk:
+            counted = (
+                pa.concat_tables(self._chunk).group_by(self.keys).aggregate([([], "count_all")])
+            )
+            self._counted.append(counted.rename_columns([*self.keys, self.name]))
+        self._chunk, self._chunk_rows = [], 0
+        if len(self._counted) >= _DIMENSION_PARTS_BEFORE_MERGE:
+            self._counted = [self._summed()]
+
+    def _summed(self) -> pa.Table:
+        summed = pa.concat_tables(self._counted).group_by(self.keys).aggregate([(self.name, "sum")])
+        return summed.rename_columns([*self.keys, self.name])
+
+    def finish(self) -> pa.Table:
+        """The counts, one row per combination, sorted by the keys."""
+        self._count_chunk()
+        if not self._counted:
+            return pa.table(
+                {
+                    **{k: pa.array([], CANONICAL_SCHEMA.field(k).type) for k in self.keys},
+                    self.name: pa.array([], pa.int64()),
+                }
+            )
+        summed = self._summed()
+        return summed.sort_by([(key, "ascending") for key in self.keys])
+
+
+def _counts_frame(counts: pa.Table) -> pd.DataFrame:
+    frame = counts.to_pandas()
+    frame["mmsi"] = frame["mmsi"].astype(np.int64)
+    frame["n_positions"] = frame["n_positions"].astype(np.int64)
+    return frame
 
 
 @dataclass(frozen=True)
@@ -273,12 +412,12 @@ def _read_dataset(
     query: Query,
     columns: Sequence[str],
     ledger: RejectsLedger,
-    collected: _Collected,
+    keep: Callable[[pa.Table], None],
     bar: ProgressSink,
 ) -> tuple[InputFile, ...]:
-    """Read a dataset's positions in the query into ``collected``, with the query pushed
-    down into the scan (``dataset_scan.position_filter``); its static reports and the
-    dimension reports of its vessels are counted at the end (``_Collected.finish``).
+    """Hand a dataset's positions in the query to ``keep``, with the query pushed down into
+    the scan (``dataset_scan.position_filter``); the caller counts the dimension reports of
+    its vessels (``_dataset_reports``).
 
     The ledger is the inputs' own (what reading the files themselves counted), with the
     dataset's rows, all used at ingest, shared out again: the static reports are used, as
@@ -291,13 +430,12 @@ def _read_dataset(
     kept = 0
     for table in dataset.scan(position_filter(query), columns):
         inside = rows_in_query(table, query)
-        collected.kept.append(table.filter(pa.array(inside)))
+        keep(table if inside.all() else table.filter(pa.array(inside)))
         kept += int(inside.sum())
     part = dataset.ingest_ledger()
     part.rows_used = dataset.static_rows
     part.outside_query(dataset.rows - dataset.static_rows - kept)
     ledger.merge(part)
-    collected.datasets.append(dataset)
     bar.advance(dataset.size_bytes)
     return tuple(
         InputFile(Path(item.path), item.sha256, item.layout, item.rows_read, dataset.directory)
@@ -310,26 +448,25 @@ def _dataset_reports(dataset: Dataset, vessels: np.ndarray) -> pa.Table:
     reports, at any time and place, as a file's are counted (``_count_reports``)."""
     from .dataset_scan import reports_filter
 
-    parts = []
+    counts = _Counts(["mmsi", *DIMENSIONS], "n_reports")
     for table in dataset.scan(reports_filter(vessels.tolist()), ["mmsi", *DIMENSIONS]):
-        groups = table.group_by(table.column_names, use_threads=False).aggregate(
-            [([], "count_all")]
-        )
-        length_m, breadth_m, draught_m = plausible(_canonical_dimensions(groups))
-        reported = any_dimension(length_m, breadth_m, draught_m)
-        parts.append(
+        counts.add(table)
+    groups = counts.finish()
+    length_m, breadth_m, draught_m = plausible(_canonical_dimensions(groups))
+    reported = any_dimension(length_m, breadth_m, draught_m)
+    empty = np.empty(0)
+    return _sum_counts(
+        [
+            _report_rows(empty, empty, empty, empty),
             _report_rows(
                 groups.column("mmsi").to_numpy()[reported],
                 length_m[reported],
                 breadth_m[reported],
                 draught_m[reported],
-                groups.column("count_all").to_numpy()[reported],
-            )
-        )
-        if len(parts) >= _DIMENSION_PARTS_BEFORE_MERGE:
-            parts = [_sum_counts(parts)]
-    empty = np.empty(0)
-    return _sum_counts([_report_rows(empty, empty, empty, empty), *parts])
+                groups.column("n_reports").to_numpy()[reported],
+            ),
+        ]
+    )
 
 
 def no_positions_error(
@@ -1215,12 +1352,16 @@ class _Collected:
             counts = _subtract_counts(counts, dropped)
             positions = positions.loc[~duplicate].reset_index(drop=True)
         ledger.use(len(positions))
-        vessels = np.unique(positions["mmsi"].to_numpy())
-        frame = counts.to_pandas()
-        reports = frame[frame["mmsi"].isin(vessels) & (frame["n_reports"] > 0)]
-        reports = reports.sort_values(["mmsi", *DIMENSIONS], ignore_index=True)
-        reports["n_reports"] = reports["n_reports"].astype(np.int64)
-        return positions, reports[list(DIMENSION_REPORT_COLUMNS)]
+        return positions, _reports_frame(counts, np.unique(positions["mmsi"].to_numpy()))
+
+
+def _reports_frame(counts: pa.Table, vessels: np.ndarray) -> pd.DataFrame:
+    """``AisData.dimension_reports``: the counted reports of ``vessels``, sorted."""
+    frame = counts.to_pandas()
+    reports = frame[frame["mmsi"].isin(vessels) & (frame["n_reports"] > 0)]
+    reports = reports.sort_values(["mmsi", *DIMENSIONS], ignore_index=True)
+    reports["n_reports"] = reports["n_reports"].astype(np.int64)
+    return reports[list(DIMENSION_REPORT_COLUMNS)]
 
 
 def _subtract_counts(counts: pa.Table, dropped: pd.DataFrame) -> pa.Table:

@@ -22,7 +22,7 @@ from .html_report import HTML_NAME, stats_html
 from .manifest import inputs_manifest, query_manifest, run_header
 
 if TYPE_CHECKING:
-    from ..ais.load import AisData
+    from ..ais.load import CountedAis
     from ..dimensions import StatsResult, StatsTable
     from ..query import Query
 
@@ -134,6 +134,26 @@ def type_colours(result: StatsResult) -> dict[str, str]:
     }
 
 
+def histogram_bins(values: np.ndarray, units: np.ndarray) -> int:
+    """How many bins for sorted ``values``, each standing for ``units`` units: the finer of
+    Sturges' and Freedman-Diaconis' rules over the units (numpy's classic ``"auto"``, which
+    takes no weights), at most ``HISTOGRAM_MAX_BINS``."""
+    n = int(units.sum())
+    span = float(values[-1] - values[0])
+    if span <= 0.0:
+        return 1
+    bins = math.ceil(math.log2(n) + 1.0)
+    # The quartiles of the units' values: the values at those places of the sorted units.
+    cumulative = np.cumsum(units)
+    lower_quartile, upper_quartile = values[
+        np.searchsorted(cumulative, [(n - 1) // 4, 3 * (n - 1) // 4], side="right")
+    ]
+    spread = float(upper_quartile - lower_quartile)
+    if spread > 0.0:
+        bins = max(bins, math.ceil(span / (2.0 * spread * n ** (-1.0 / 3.0))))
+    return min(bins, HISTOGRAM_MAX_BINS)
+
+
 def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     """Three histograms (length, breadth, draught) of the counted units' values, stacked by
     ship type when the statistics are grouped by it: each type in its colour in every panel
@@ -146,29 +166,29 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     axes = figure.subplots(1, 3)
     colours = type_colours(result)
     for axis, (dimension, label) in zip(axes, DIMENSION_LABELS.items(), strict=True):
-        samples = result.samples[["ship_type", dimension]].dropna(subset=[dimension])
+        samples = result.samples.loc[result.samples["units"] > 0, ["ship_type", dimension, "units"]]
+        samples = samples.dropna(subset=[dimension]).sort_values(dimension, kind="stable")
         values = samples[dimension].to_numpy(dtype=float)
+        units = samples["units"].to_numpy(dtype=np.int64)
         if values.size:
-            bins = min(HISTOGRAM_MAX_BINS, len(np.histogram_bin_edges(values, bins="auto")) - 1)
-            edges = np.histogram_bin_edges(values, bins=max(bins, 1))
+            edges = np.histogram_bin_edges(values, bins=histogram_bins(values, units))
             if result.by is None:
-                axis.hist(values, bins=edges, color="tab:blue", edgecolor="white")
+                axis.hist(values, bins=edges, weights=units, color="tab:blue", edgecolor="white")
             else:
                 # Stacked by ship type: the bars' heights are the overall histogram's.
-                types = samples["ship_type"].astype(str)
-                groups = [
-                    (name, values[types == name]) for name in colours if (types == name).any()
-                ]
+                types = samples["ship_type"].astype(str).to_numpy()
+                groups = [name for name in colours if (types == name).any()]
                 axis.hist(
-                    [group for _, group in groups],
+                    [values[types == name] for name in groups],
                     bins=edges,
+                    weights=[units[types == name] for name in groups],
                     stacked=True,
-                    color=[colours[name] for name, _ in groups],
+                    color=[colours[name] for name in groups],
                     edgecolor="white",
                     linewidth=0.3,
                 )
                 # One bar container per type, in the order given.
-                for stack, (name, _) in zip(axis.containers, groups, strict=True):
+                for stack, name in zip(axis.containers, groups, strict=True):
                     stack.set_label(name)
         else:
             axis.text(0.5, 0.5, "no values", ha="center", va="center", transform=axis.transAxes)
@@ -178,7 +198,7 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
         axis.set_xlabel(label)
         axis.set_ylabel(result.unit_name)
         # A set height spares matplotlib its search for tick labels above the axes.
-        axis.set_title(f"{label}: n = {values.size}", y=1.0)
+        axis.set_title(f"{label}: n = {int(units.sum())}", y=1.0)
     figure.suptitle(_title(result, query_name))
     if colours:
         figure.subplots_adjust(right=0.86)
@@ -191,7 +211,7 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     return figure
 
 
-def build_manifest(result: StatsResult, query: Query, data: AisData) -> dict[str, Any]:
+def build_manifest(result: StatsResult, query: Query, data: CountedAis) -> dict[str, Any]:
     """The content of run.json: what was read, what the query kept, and the result."""
     return {
         **run_header("stats"),
