@@ -17,7 +17,8 @@ from pyais import encode_dict
 from colregs9_cli.ais.batch import AisBatch
 from colregs9_cli.ais.clean import SHIP_TYPE_CATEGORIES
 from colregs9_cli.ais.ledger import RejectReason, RejectsLedger
-from colregs9_cli.ais.nmea import DEFAULT_TIME_SOURCES, TimeSource, pghp_time_ms, read_nmea
+from colregs9_cli.ais.nmea import pghp_time_ms, read_nmea
+from colregs9_cli.ais.time_sources import DEFAULT_TIME_SOURCES, TimeSource
 from colregs9_cli.errors import InputFileError
 
 NOON = 1_384_257_600  # 2013-11-12 12:00:00 UTC

@@ -180,7 +180,7 @@ def test_chart_inputs_name_every_chart_format(name: str, marker: str) -> None:
 
 def test_replay_and_stats_help_name_what_they_write() -> None:
     from colregs9_cli.report import replay_report, stats_report
-    from colregs9_cli.report.html_report import HTML_NAME
+    from colregs9_cli.report.html_page import HTML_NAME
     from colregs9_cli.report.replay_geopackage import GEOPACKAGE_NAME
 
     written = {

@@ -6,7 +6,7 @@ import dataclasses
 import re
 import tomllib
 
-from colregs9_cli.ais.nmea import IngestParams
+from colregs9_cli.ais.time_sources import IngestParams
 from colregs9_cli.colregs import ColregsParams, colregs_params_from_table
 from colregs9_cli.config import dataclass_from_table
 from colregs9_cli.manoeuvrability import ManoeuvrabilityParams

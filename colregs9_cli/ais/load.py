@@ -107,10 +107,10 @@ from .sources import (
     read_head,
     sha256_file,
 )
+from .time_sources import IngestParams
 
 if TYPE_CHECKING:
     from .dataset_scan import Dataset
-    from .nmea import IngestParams
 
 __all__ = [
     "LAYOUTS",
@@ -1130,7 +1130,6 @@ def _table_example(name: str, table: pa.Table) -> Example:
 def ingest_params(query: Query) -> IngestParams:
     """The query's ``[ingest]`` table, checked (``ParameterError`` naming the file)."""
     from ..config import dataclass_from_table
-    from .nmea import IngestParams
 
     where = f"{query.source if query.source is not None else 'query'} [ingest]"
     return dataclass_from_table(IngestParams, dict(query.tables.get("ingest", {})), where)

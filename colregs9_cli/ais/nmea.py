@@ -69,7 +69,6 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
-from enum import StrEnum
 from typing import cast
 
 import numpy as np
@@ -91,7 +90,6 @@ from pyais.messages import (
     TagBlock,
 )
 
-from ..errors import ParameterError
 from .batch import STATIC_SCHEMA, AisBatch
 from .clean import (
     MAX_BREADTH_M,
@@ -104,6 +102,7 @@ from .clean import (
 )
 from .ledger import DropReason, RejectReason, RejectsLedger
 from .schema import CANONICAL_SCHEMA
+from .time_sources import DEFAULT_TIME_SOURCES, TimeSource
 
 POSITION_TYPES = frozenset({1, 2, 3, 18, 19, 27})
 STATIC_TYPES = frozenset({5, 24})
@@ -117,19 +116,6 @@ _MAX_UNIX_S = 4_102_444_800  # 2100-01-01: larger values are not plausible recei
 _UNIX_MS_THRESHOLD = 1e11  # above this a c: value is milliseconds
 
 
-class TimeSource(StrEnum):
-    """Where a message's time came from (module docstring)."""
-
-    TAG_BLOCK = "tag_block"
-    PGHP = "pghp"
-    ARRIVAL = "arrival"
-
-
-DEFAULT_TIME_SOURCES: tuple[TimeSource, ...] = (
-    TimeSource.TAG_BLOCK,
-    TimeSource.PGHP,
-    TimeSource.ARRIVAL,
-)
 # A message's time: milliseconds since the epoch, and its source.
 _Stamp = tuple[int, TimeSource]
 # The time of a message kept without one (``keep_timeless``): a null timestamp in the tables.
@@ -142,29 +128,6 @@ class NmeaCounts:
     """What a read found besides the ledger: the AIS messages that had no time."""
 
     timeless: int = 0
-
-
-@dataclass(frozen=True)
-class IngestParams:
-    """The ``[ingest]`` table of a query: how raw NMEA is read.
-
-    - ``nmea_time_sources``: the time sources to use, in order of precedence (module
-      docstring); the default puts the observation (``tag_block``, ``pghp``) before the
-      ``arrival`` at the archive.
-    """
-
-    nmea_time_sources: tuple[TimeSource, ...] = DEFAULT_TIME_SOURCES
-
-    def __post_init__(self) -> None:
-        names = [str(s) for s in self.nmea_time_sources]
-        allowed = [s.value for s in TimeSource]
-        bad = [n for n in names if n not in allowed]
-        if not names or bad or len(set(names)) != len(names):
-            raise ParameterError(
-                f"[ingest] nmea_time_sources = {names!r}: give each of {', '.join(allowed)} "
-                "at most once, at least one, in order of precedence"
-            )
-        object.__setattr__(self, "nmea_time_sources", tuple(TimeSource(n) for n in names))
 
 
 def _bits_through(cls: type[Payload], last_field: str) -> int:

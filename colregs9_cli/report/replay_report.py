@@ -44,7 +44,8 @@ from .chart_plot import (
     geographic_axes,
     show_view,
 )
-from .html_report import HTML_NAME, replay_html
+from .html_page import HTML_NAME
+from .html_report import replay_html
 from .replay_geopackage import GEOPACKAGE_NAME, encounter_layers, write_replay_geopackage
 
 if TYPE_CHECKING:

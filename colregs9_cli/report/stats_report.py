@@ -18,7 +18,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from .atomic import report_directory, save_figure, write_csv, write_json, write_text
-from .html_report import HTML_NAME, stats_html
+from .html_page import HTML_NAME, stats_html
 from .manifest import inputs_manifest, query_manifest, run_header
 
 if TYPE_CHECKING:
