@@ -252,8 +252,9 @@ def _load(
 @dataclass(frozen=True)
 class CountedAis:
     """``AisData`` with the positions counted: ``position_counts`` holds
-    ``dimensions.POSITION_COUNT_COLUMNS``, one row per distinct (mmsi, ship type, dimensions) of the
-    positions, sorted, with how many positions have them (``n_positions``)."""
+    ``dimensions.POSITION_COUNT_COLUMNS``, one row per distinct (mmsi, ship type,
+    dimensions) of the positions, sorted, with how many positions have them
+    (``n_positions``)."""
 
     position_counts: pd.DataFrame
     dimension_reports: pd.DataFrame
