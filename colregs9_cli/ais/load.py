@@ -252,9 +252,8 @@ def _load(
 @dataclass(frozen=True)
 class CountedAis:
     """``AisData`` with the positions counted: ``position_counts`` holds
-    ``dimensions.POSITION_COUNT_COLUMNS``, one row per distinct (mmsi, ship type,
-    dimensions) of the positions, sorted, with how many positions have them
-    (``n_positions``)."""
+    ``dimensions.POSITION_COLUMNS``, one row per distinct (mmsi, ship type, dimensions) of
+    the positions, sorted, and ``n_positions``, how many positions have them."""
 
     position_counts: pd.DataFrame
     dimension_reports: pd.DataFrame
@@ -284,7 +283,7 @@ def count_ais(
         data = _load(sources, query, fmt, quiet, started, POSITION_COLUMNS, False, False)
         counts.add(pa.Table.from_pandas(data.positions, preserve_index=False))
         return CountedAis(
-            _counts_frame(counts.finish()),
+            counts.finish().to_pandas(),
             data.dimension_reports,
             data.ledger,
             data.inputs,
@@ -298,7 +297,7 @@ def count_ais(
         "Reading AIS", float(dataset.size_bytes), progress_enabled(quiet), in_bytes=True
     ) as bar:
         inputs = _read_dataset(dataset, query, scanned, ledger, counts.add, bar)
-    position_counts = _counts_frame(counts.finish())
+    position_counts = counts.finish().to_pandas()
     kept = int(position_counts["n_positions"].sum())
     ledger.use(kept)
     if kept == 0:
@@ -330,14 +329,12 @@ class _Counts:
             counted = (
                 pa.concat_tables(self._chunk).group_by(self.keys).aggregate([([], "count_all")])
             )
-            self._counted.append(counted.rename_columns([*self.keys, self.name]))
+            self._counted.append(
+                counted.select([*self.keys, "count_all"]).rename_columns([*self.keys, self.name])
+            )
         self._chunk, self._chunk_rows = [], 0
         if len(self._counted) >= _DIMENSION_PARTS_BEFORE_MERGE:
-            self._counted = [self._summed()]
-
-    def _summed(self) -> pa.Table:
-        summed = pa.concat_tables(self._counted).group_by(self.keys).aggregate([(self.name, "sum")])
-        return summed.rename_columns([*self.keys, self.name])
+            self._counted = [_sum_by(self._counted, self.keys, self.name)]
 
     def finish(self) -> pa.Table:
         """The counts, one row per combination, sorted by the keys."""
@@ -349,15 +346,21 @@ class _Counts:
                     self.name: pa.array([], pa.int64()),
                 }
             )
-        summed = self._summed()
+        summed = _sum_by(self._counted, self.keys, self.name)
         return summed.sort_by([(key, "ascending") for key in self.keys])
 
 
-def _counts_frame(counts: pa.Table) -> pd.DataFrame:
-    frame = counts.to_pandas()
-    frame["mmsi"] = frame["mmsi"].astype(np.int64)
-    frame["n_positions"] = frame["n_positions"].astype(np.int64)
-    return frame
+def _sum_by(
+    tables: Sequence[pa.Table], keys: Sequence[str], name: str, use_threads: bool = True
+) -> pa.Table:
+    """The rows of ``tables``, one per distinct combination of ``keys`` (nulls included),
+    with the sum of their column ``name``: Arrow's hash grouping."""
+    summed = (
+        pa.concat_tables(tables)
+        .group_by(list(keys), use_threads=use_threads)
+        .aggregate([(name, "sum")])
+    )
+    return summed.select([*keys, f"{name}_sum"]).rename_columns([*keys, name])
 
 
 @dataclass(frozen=True)
@@ -455,17 +458,16 @@ def _dataset_reports(dataset: Dataset, vessels: np.ndarray) -> pa.Table:
     groups = counts.finish()
     length_m, breadth_m, draught_m = plausible(_canonical_dimensions(groups))
     reported = any_dimension(length_m, breadth_m, draught_m)
-    empty = np.empty(0)
+    # Raw values that clean alike (implausible ones become null) are summed.
     return _sum_counts(
         [
-            _report_rows(empty, empty, empty, empty),
             _report_rows(
                 groups.column("mmsi").to_numpy()[reported],
                 length_m[reported],
                 breadth_m[reported],
                 draught_m[reported],
                 groups.column("n_reports").to_numpy()[reported],
-            ),
+            )
         ]
     )
 
@@ -762,14 +764,7 @@ def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
     Arrow's hash grouping, about twice as fast as pandas'; on the calling thread, as the CSV
     reader keeps pyarrow's thread pool busy.
     """
-    summed = (
-        pa.concat_tables(parts)
-        .group_by(["mmsi", *DIMENSIONS], use_threads=False)
-        .aggregate([("n_reports", "sum")])
-    )
-    return summed.select(["mmsi", *DIMENSIONS, "n_reports_sum"]).rename_columns(
-        DIMENSION_REPORT_COLUMNS
-    )
+    return _sum_by(parts, ["mmsi", *DIMENSIONS], "n_reports", use_threads=False)
 
 
 def _read_source(
