@@ -9,7 +9,7 @@ distinct report weighted by how often it was sent (the median of the expanded li
 reports, the mean of the two middle reports when their number is even). Per message, every
 position row in the query that carries a value counts once.
 
-The positions come as counts (``POSITION_COLUMNS`` and ``n_positions``): each row stands
+The positions come as counts (``STATS_POSITION_COLUMNS`` and ``n_positions``): each row stands
 for ``n_positions`` position messages with its MMSI, ship type and dimensions. A reader can so
 count the positions as it scans them (``ais.load.count_ais``) rather than hold them, and
 the statistics per message are those of the messages the rows stand for, whatever the
@@ -30,9 +30,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-DIMENSIONS: tuple[str, ...] = ("length_m", "breadth_m", "draught_m")
-# The columns of the positions ``dimension_stats`` uses: a dataset is read for these alone.
-POSITION_COLUMNS: tuple[str, ...] = ("mmsi", "ship_type", *DIMENSIONS)
+from .ais.schema import DIMENSIONS
+
 STAT_COLUMNS: tuple[str, ...] = ("count", "mean", "median", "std", "min", "max")
 # Vessels whose ship type is never reported are grouped under this label with ``--by``.
 NO_SHIP_TYPE = "Unknown"
@@ -241,7 +240,7 @@ def dimension_stats(
 ) -> StatsResult:
     """Dimension statistics over the vessels (or position messages) of ``position_counts``.
 
-    ``position_counts``: ``POSITION_COLUMNS`` and ``n_positions``, the position rows selected
+    ``position_counts``: ``STATS_POSITION_COLUMNS`` and ``n_positions``, the position rows selected
     by the query, each row standing for ``n_positions`` of them (see the module docstring).
     ``dimension_reports``: ``mmsi, length_m, breadth_m, draught_m, n_reports``, the distinct
     reported combinations over the whole input with how often each was sent (used per vessel

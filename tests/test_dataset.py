@@ -17,7 +17,7 @@ import pyarrow.parquet as pq
 import pytest
 from typer.testing import CliRunner
 
-from colregs9_cli.ais import load as load_module
+from colregs9_cli.ais import counting
 from colregs9_cli.ais.dataset import (
     dataset_time_range,
     ingest,
@@ -26,9 +26,8 @@ from colregs9_cli.ais.dataset import (
 )
 from colregs9_cli.ais.dataset_scan import MANIFEST_NAME, Dataset, position_filter
 from colregs9_cli.ais.load import AisData, count_ais, load_ais
-from colregs9_cli.ais.schema import CANONICAL_SCHEMA
+from colregs9_cli.ais.schema import CANONICAL_SCHEMA, STATS_POSITION_COLUMNS
 from colregs9_cli.cli import app
-from colregs9_cli.dimensions import POSITION_COLUMNS
 from colregs9_cli.errors import InputFileError, NoDataError
 from colregs9_cli.query import Query, Region, TimeWindow, VesselFilter, load_query
 
@@ -225,7 +224,7 @@ def test_stats_over_the_dataset_equals_stats_over_the_files(
 
 def _counted_by_pandas(data: AisData) -> pd.DataFrame:
     """The positions counted by their MMSI, ship type and dimensions, with pandas."""
-    keys = list(POSITION_COLUMNS)
+    keys = list(STATS_POSITION_COLUMNS)
     counts = data.positions[keys].groupby(keys, dropna=False).size()
     return counts.rename("n_positions").reset_index()
 
@@ -246,7 +245,7 @@ def test_a_dataset_is_counted_as_it_is_scanned(
     """Counted in chunks of any size, the positions of a dataset read alone are those of the
     file, counted; the reports and the ledger are the file's too."""
     assert Dataset.open(nmea_dataset).duplicate_free  # so no position row is held
-    monkeypatch.setattr(load_module, "_COUNT_CHUNK_ROWS", chunk_rows)
+    monkeypatch.setattr(counting, "COUNT_CHUNK_ROWS", chunk_rows)
     query = QUERIES.get(name)
     try:
         want = load_ais([nmea], query)

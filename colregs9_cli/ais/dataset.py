@@ -69,7 +69,9 @@ from .dataset_scan import (
     manifest_schema,
     ms_date,
     position_filter,
+    positions_in_query,
     read_manifest,
+    scan_columns,
     utc_ms,
 )
 from .ledger import RejectReason, RejectsLedger
@@ -78,8 +80,6 @@ from .load import (
     check_format,
     ingest_params,
     no_positions_error,
-    rows_in_query,
-    scan_columns,
     stream_ais,
 )
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
@@ -613,10 +613,7 @@ def read_window_counted(
     expression = position_filter(query, utc_ms(start), utc_ms(end))
     if mmsis is not None:
         expression &= (ds.field("mmsi") >= mmsis[0]) & (ds.field("mmsi") <= mmsis[1])
-    tables = [
-        table.filter(pa.array(rows_in_query(table, query)))
-        for table in dataset.scan(expression, read)
-    ]
+    tables = list(positions_in_query(dataset, query, read, expression))
     schema = pa.schema([CANONICAL_SCHEMA.field(name) for name in read])
     table = pa.concat_tables(tables) if tables else schema.empty_table()
     order = pc.sort_indices(table, sort_keys=[("mmsi", "ascending"), ("timestamp", "ascending")])

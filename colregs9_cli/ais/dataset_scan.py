@@ -28,7 +28,8 @@ import pyarrow.dataset as ds
 from ..errors import InputFileError
 from ..query import Query
 from .ledger import RejectsLedger
-from .schema import CANONICAL_SCHEMA
+from .query_rows import rows_in_query
+from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
 
 MANIFEST_NAME = "colregs9-dataset.json"
 DATASET_FORMAT = "colregs9-dataset"
@@ -331,6 +332,19 @@ def _check_fragment(fragment: ds.ParquetFileFragment, listed: DatasetFile, path:
     return static
 
 
+def scan_columns(wanted: Sequence[str], query: Query, ordered: bool = True) -> tuple[str, ...]:
+    """The columns to read for ``wanted`` columns of the positions in ``query``: also those
+    the query tests, and the sort keys (mmsi, timestamp) when the rows are to be ``ordered``."""
+    needed = {*wanted, "mmsi"}
+    if ordered or not query.time.unbounded:
+        needed.add("timestamp")
+    if query.region is not None:
+        needed |= {"lat_deg", "lon_deg"}
+    if not query.vessels.selects_all:
+        needed |= {"mobile_type", "ship_type", "length_m"}
+    return tuple(c for c in CANONICAL_COLUMNS if c in needed)
+
+
 def position_filter(
     query: Query, start_ms: int | None = None, end_ms: int | None = None
 ) -> ds.Expression:
@@ -367,6 +381,17 @@ def position_filter(
     if vessels.length_max_m is not None:
         expression &= ds.field("length_m") <= vessels.length_max_m
     return expression
+
+
+def positions_in_query(
+    dataset: Dataset, query: Query, columns: Sequence[str], expression: ds.Expression
+) -> Iterator[pa.Table]:
+    """The position rows of ``query`` that the scan with ``expression`` (the query's
+    pushdown, ``position_filter``, or narrower) selects, batch by batch: the rows of each
+    batch outside the query (its polygon, its ship types) are dropped."""
+    for table in dataset.scan(expression, columns):
+        inside = rows_in_query(table, query)
+        yield table if inside.all() else table.filter(pa.array(inside))
 
 
 def reports_filter(vessels: Sequence[int]) -> ds.Expression:

@@ -71,7 +71,6 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from ..dimensions import POSITION_COLUMNS
 from ..errors import InputFileError, NoDataError, ParameterError
 from ..progress import ProgressSink, progress_bar, progress_enabled
 from ..query import Query, everything_query
@@ -93,11 +92,13 @@ from .clean import (
 )
 from .column_map import MAP_PREFIX
 from .columns import file_map
+from .counting import PARTS_BEFORE_MERGE, RowCounts, sum_by
 from .csv_chunks import CsvChunk, CutRows, NotUtf8, ParsedRows, parse_cut_rows
 from .csv_read import CsvReading, missing_columns
 from .detect import LAYOUTS, csv_header, detect_layout, is_csv_layout, known_layout
 from .ledger import DropReason, RejectReason, RejectsLedger
-from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
+from .query_rows import rows_in_window_and_filter
+from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA, DIMENSIONS, STATS_POSITION_COLUMNS
 from .sources import (
     Source,
     decompression_error,
@@ -110,6 +111,7 @@ from .sources import (
 from .time_sources import IngestParams
 
 if TYPE_CHECKING:
+    from .dataset_count import CountingAhead
     from .dataset_scan import Dataset
 
 __all__ = [
@@ -123,20 +125,13 @@ __all__ = [
     "count_ais",
     "load_ais",
     "no_positions_error",
-    "rows_in_query",
-    "scan_columns",
     "stream_ais",
 ]
 
 PARQUET_BATCH_ROWS = 256 * 1024
-DIMENSIONS = ("length_m", "breadth_m", "draught_m")
 DIMENSION_REPORT_COLUMNS = ("mmsi", *DIMENSIONS, "n_reports")
 _EXAMPLE_CHARS = 160
 _DECIMAL = re.compile(r"[-+]?\d+(\.\d*)?")
-# Merge the per-block dimension counts once this many have piled up.
-_DIMENSION_PARTS_BEFORE_MERGE = 64
-# Rows grouped at once when positions or reports are counted (``_Counts``).
-_COUNT_CHUNK_ROWS = 1 << 20
 # Convert the rows set aside once they hold this many bytes (see ``_FileResult.set_aside``).
 _SET_ASIDE_BYTES = 8 * 1024 * 1024
 
@@ -222,9 +217,11 @@ def _load(
 ) -> AisData:
     ledger = RejectsLedger()
     collected = _Collected(may_repeat=not _dataset_alone(sources), ordered=ordered)
-    scanned = (
-        scan_columns(wanted, query, ordered) if not collected.may_repeat else CANONICAL_COLUMNS
-    )
+    scanned: Sequence[str] = CANONICAL_COLUMNS
+    if not collected.may_repeat:
+        from .dataset_scan import scan_columns
+
+        scanned = scan_columns(wanted, query, ordered)
     inputs: list[InputFile] = []
     total_bytes = float(sum(s.size_bytes for s in sources))
     with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet), in_bytes=True) as bar:
@@ -252,7 +249,7 @@ def _load(
 @dataclass(frozen=True)
 class CountedAis:
     """``AisData`` with the positions counted: ``position_counts`` holds
-    ``dimensions.POSITION_COLUMNS``, one row per distinct (mmsi, ship type, dimensions) of
+    ``schema.STATS_POSITION_COLUMNS``, one row per distinct (mmsi, ship type, dimensions) of
     the positions, sorted, and ``n_positions``, how many positions have them."""
 
     position_counts: pd.DataFrame
@@ -268,19 +265,27 @@ def count_ais(
     fmt: str | None = None,
     quiet: bool = True,
     started: CsvReading | None = None,
+    ahead: CountingAhead | None = None,
 ) -> CountedAis:
     """What ``load_ais(..., needs_time=False)`` reads, with the positions counted by their
     MMSI, ship type and dimensions (``CountedAis``): what the dimension statistics need.
 
     One dataset read alone holds no duplicates (``_dataset_alone``): it is counted as it is
-    scanned, in memory set by the vessels, not by the rows. Other inputs are loaded whole, as
-    duplicates across them are found among all their rows, and then counted.
+    scanned (``dataset_count``), in memory set by the vessels, not by the rows; ``ahead`` is
+    that count already started (``dataset_count.count_ahead``) for ``paths`` and ``query``.
+    Other inputs are loaded whole, as duplicates across them are found among all their rows,
+    and then counted.
     """
     query = query if query is not None else everything_query()
+    if ahead is not None:
+        assert ahead.query is query, "counted ahead for this query"
+        ingest_params(query)
+        check_format(fmt)
+        return _counted_dataset(ahead.dataset, query, quiet, ahead)
     sources = _open_inputs(paths, query, fmt)
-    counts = _Counts(POSITION_COLUMNS, "n_positions")
     if not _dataset_alone(sources):
-        data = _load(sources, query, fmt, quiet, started, POSITION_COLUMNS, False, False)
+        counts = RowCounts(STATS_POSITION_COLUMNS, "n_positions")
+        data = _load(sources, query, fmt, quiet, started, STATS_POSITION_COLUMNS, False, False)
         counts.add(pa.Table.from_pandas(data.positions, preserve_index=False))
         return CountedAis(
             counts.finish().to_pandas(),
@@ -291,76 +296,29 @@ def count_ais(
         )
     dataset = sources[0]
     assert not isinstance(dataset, Source), "_dataset_alone: a dataset"
-    ledger = RejectsLedger()
-    scanned = scan_columns(POSITION_COLUMNS, query, ordered=False)
+    return _counted_dataset(dataset, query, quiet, None)
+
+
+def _counted_dataset(
+    dataset: Dataset, query: Query, quiet: bool, ahead: CountingAhead | None
+) -> CountedAis:
+    from .dataset_count import count_dataset
+
     with progress_bar(
         "Reading AIS", float(dataset.size_bytes), progress_enabled(quiet), in_bytes=True
     ) as bar:
-        inputs = _read_dataset(dataset, query, scanned, ledger, counts.add, bar)
-    position_counts = counts.finish().to_pandas()
+        counted = ahead.result() if ahead is not None else count_dataset(dataset, query)
+        bar.advance(dataset.size_bytes)
+    position_counts = counted.position_counts.to_pandas()
     kept = int(position_counts["n_positions"].sum())
+    ledger = RejectsLedger()
+    inputs = _dataset_inputs(dataset, kept, ledger)
     ledger.use(kept)
     if kept == 0:
         raise no_positions_error(inputs, ledger, query)
     vessels = np.unique(position_counts["mmsi"].to_numpy())
-    reports = _reports_frame(_dataset_reports(dataset, vessels), vessels)
+    reports = _reports_frame(_cleaned_reports(counted.report_counts), vessels)
     return CountedAis(position_counts, reports, ledger, inputs, kept)
-
-
-class _Counts:
-    """How many rows of the tables added have each distinct combination of ``keys``
-    (nulls included), in the column ``name``. Arrow's hash grouping runs over chunks of
-    about ``_COUNT_CHUNK_ROWS`` rows: a grouping costs per call, and a chunk bounds memory."""
-
-    def __init__(self, keys: Sequence[str], name: str) -> None:
-        self.keys, self.name = list(keys), name
-        self._chunk: list[pa.Table] = []
-        self._chunk_rows = 0
-        self._counted: list[pa.Table] = []
-
-    def add(self, table: pa.Table) -> None:
-        self._chunk.append(table.select(self.keys))
-        self._chunk_rows += table.num_rows
-        if self._chunk_rows >= _COUNT_CHUNK_ROWS:
-            self._count_chunk()
-
-    def _count_chunk(self) -> None:
-        if self._chunk:
-            counted = (
-                pa.concat_tables(self._chunk).group_by(self.keys).aggregate([([], "count_all")])
-            )
-            self._counted.append(
-                counted.select([*self.keys, "count_all"]).rename_columns([*self.keys, self.name])
-            )
-        self._chunk, self._chunk_rows = [], 0
-        if len(self._counted) >= _DIMENSION_PARTS_BEFORE_MERGE:
-            self._counted = [_sum_by(self._counted, self.keys, self.name)]
-
-    def finish(self) -> pa.Table:
-        """The counts, one row per combination, sorted by the keys."""
-        self._count_chunk()
-        if not self._counted:
-            return pa.table(
-                {
-                    **{k: pa.array([], CANONICAL_SCHEMA.field(k).type) for k in self.keys},
-                    self.name: pa.array([], pa.int64()),
-                }
-            )
-        summed = _sum_by(self._counted, self.keys, self.name)
-        return summed.sort_by([(key, "ascending") for key in self.keys])
-
-
-def _sum_by(
-    tables: Sequence[pa.Table], keys: Sequence[str], name: str, use_threads: bool = True
-) -> pa.Table:
-    """The rows of ``tables``, one per distinct combination of ``keys`` (nulls included),
-    with the sum of their column ``name``: Arrow's hash grouping."""
-    summed = (
-        pa.concat_tables(tables)
-        .group_by(list(keys), use_threads=use_threads)
-        .aggregate([(name, "sum")])
-    )
-    return summed.select([*keys, f"{name}_sum"]).rename_columns([*keys, name])
 
 
 @dataclass(frozen=True)
@@ -390,19 +348,6 @@ def _dataset_alone(sources: Sequence[Source | Dataset]) -> bool:
     return len(sources) == 1 and not isinstance(sources[0], Source) and sources[0].duplicate_free
 
 
-def scan_columns(wanted: Sequence[str], query: Query, ordered: bool = True) -> tuple[str, ...]:
-    """The columns to read for ``wanted`` columns of the positions in ``query``: also those
-    the query tests, and the sort keys (mmsi, timestamp) when the rows are to be ``ordered``."""
-    needed = {*wanted, "mmsi"}
-    if ordered or not query.time.unbounded:
-        needed.add("timestamp")
-    if query.region is not None:
-        needed |= {"lat_deg", "lon_deg"}
-    if not query.vessels.selects_all:
-        needed |= {"mobile_type", "ship_type", "length_m"}
-    return tuple(c for c in CANONICAL_COLUMNS if c in needed)
-
-
 def _open_input(path: Path) -> Source | Dataset:
     if not path.is_dir():
         return inspect_source(path)
@@ -420,45 +365,46 @@ def _read_dataset(
     bar: ProgressSink,
 ) -> tuple[InputFile, ...]:
     """Hand a dataset's positions in the query to ``keep``, with the query pushed down into
-    the scan (``dataset_scan.position_filter``); the caller counts the dimension reports of
-    its vessels (``_dataset_reports``).
-
-    The ledger is the inputs' own (what reading the files themselves counted), with the
-    dataset's rows, all used at ingest, shared out again: the static reports are used, as
-    in a file; the positions this query keeps are used (less duplicates across inputs,
-    found in ``finish``); the others, skipped by the pushdown or by the tests here, are
-    outside the query.
-    """
-    from .dataset_scan import position_filter
+    the scan (``dataset_scan.position_filter``); the ledger as ``_dataset_inputs`` has it."""
+    from .dataset_scan import position_filter, positions_in_query
 
     kept = 0
-    for table in dataset.scan(position_filter(query), columns):
-        inside = rows_in_query(table, query)
-        keep(table if inside.all() else table.filter(pa.array(inside)))
-        kept += int(inside.sum())
+    for table in positions_in_query(dataset, query, columns, position_filter(query)):
+        keep(table)
+        kept += table.num_rows
+    bar.advance(dataset.size_bytes)
+    return _dataset_inputs(dataset, kept, ledger)
+
+
+def _dataset_inputs(dataset: Dataset, kept: int, ledger: RejectsLedger) -> tuple[InputFile, ...]:
+    """The inputs of ``dataset``, whose ledger goes into ``ledger``: the inputs' own (what
+    reading the files themselves counted), with the dataset's rows, all used at ingest,
+    shared out again. The static reports are used, as in a file; the ``kept`` positions of
+    the query are used (less duplicates across inputs, found in ``_Collected.finish``); the
+    others, skipped by the pushdown or by the query's tests, are outside the query."""
     part = dataset.ingest_ledger()
     part.rows_used = dataset.static_rows
     part.outside_query(dataset.rows - dataset.static_rows - kept)
     ledger.merge(part)
-    bar.advance(dataset.size_bytes)
     return tuple(
         InputFile(Path(item.path), item.sha256, item.layout, item.rows_read, dataset.directory)
         for item in dataset.inputs
     )
 
 
-def _dataset_reports(dataset: Dataset, vessels: np.ndarray) -> pa.Table:
-    """The dimension reports of ``vessels`` over the whole dataset, positions and static
-    reports, at any time and place, as a file's are counted (``_count_reports``)."""
-    from .dataset_scan import reports_filter
+def _dataset_reports(dataset: Dataset, vessels: Sequence[int]) -> pa.Table:
+    """The dimension reports of ``vessels`` over the whole dataset, cleaned."""
+    from .dataset_count import count_reports
 
-    counts = _Counts(["mmsi", *DIMENSIONS], "n_reports")
-    for table in dataset.scan(reports_filter(vessels.tolist()), ["mmsi", *DIMENSIONS]):
-        counts.add(table)
-    groups = counts.finish()
+    return _cleaned_reports(count_reports(dataset, vessels))
+
+
+def _cleaned_reports(groups: pa.Table) -> pa.Table:
+    """The dimension reports counted as stored (``mmsi``, the dimensions, ``n_reports``),
+    cleaned as a file's are (``_count_reports``): rows that report no plausible dimension
+    go, and raw values that clean alike (implausible ones become null) are summed."""
     length_m, breadth_m, draught_m = plausible(_canonical_dimensions(groups))
     reported = any_dimension(length_m, breadth_m, draught_m)
-    # Raw values that clean alike (implausible ones become null) are summed.
     return _sum_counts(
         [
             _report_rows(
@@ -649,7 +595,7 @@ class _FileResult:
             )
             self._uncount_dimensions(table.filter(pa.array(bad_time)))
             table = table.filter(pa.array(~bad_time))
-        selected = _in_query(table, self.query)
+        selected = rows_in_window_and_filter(table, self.query)
         self.ledger.outside_query(int((~selected).sum()))
         if self.sink is not None:
             self.sink.positions(table.filter(pa.array(selected)))
@@ -696,7 +642,7 @@ class _FileResult:
 
     def _add_counts(self, counts: pa.Table) -> None:
         self.dimension_parts.append(counts)
-        if len(self.dimension_parts) >= _DIMENSION_PARTS_BEFORE_MERGE:
+        if len(self.dimension_parts) >= PARTS_BEFORE_MERGE:
             self.dimension_parts = [_sum_counts(self.dimension_parts)]
 
 
@@ -764,7 +710,7 @@ def _sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
     Arrow's hash grouping, about twice as fast as pandas'; on the calling thread, as the CSV
     reader keeps pyarrow's thread pool busy.
     """
-    return _sum_by(parts, ["mmsi", *DIMENSIONS], "n_reports", use_threads=False)
+    return sum_by(parts, ["mmsi", *DIMENSIONS], "n_reports", use_threads=False)
 
 
 def _read_source(
@@ -1026,42 +972,6 @@ def _time_out_of_range(table: pa.Table) -> np.ndarray:
     high = round(AIS_TIME_END.timestamp() * 1000)
     with np.errstate(invalid="ignore"):
         return np.asarray((milliseconds < low) | (milliseconds >= high), dtype=bool)
-
-
-def rows_in_query(table: pa.Table, query: Query) -> np.ndarray:
-    """The position rows of canonical ``table`` inside the query: its region (polygon too),
-    time window and vessel filter."""
-    inside = _in_query(table, query)
-    if query.region is not None:
-        inside &= query.region.contains(
-            to_numpy_float(table.column("lat_deg")), to_numpy_float(table.column("lon_deg"))
-        )
-    return inside
-
-
-def _in_query(table: pa.Table, query: Query) -> np.ndarray:
-    """Rows inside the time window and the vessel filter."""
-    keep = np.ones(table.num_rows, dtype=bool)
-    window = query.time
-    if not window.unbounded:
-        # the schema's unit: milliseconds since the epoch; a row without a time (NaN: an
-        # NMEA message read by stats) is outside any window
-        stamps = table.column("timestamp").cast(pa.int64())
-        milliseconds = (
-            to_numpy_float(stamps.cast(pa.float64())) if stamps.null_count else stamps.to_numpy()
-        )
-        if window.start is not None:
-            keep &= milliseconds >= round(window.start.timestamp() * 1000)
-        if window.end is not None:
-            keep &= milliseconds < round(window.end.timestamp() * 1000)
-    if not query.vessels.selects_all:
-        keep &= query.vessels.selects(
-            table.column("mmsi").to_numpy(),
-            table.column("mobile_type").to_numpy(zero_copy_only=False),
-            table.column("ship_type").to_numpy(zero_copy_only=False),
-            table.column("length_m").to_numpy(zero_copy_only=False),
-        )
-    return keep
 
 
 # -- canonical tables (NMEA, Parquet) ---------------------------------------------------------
@@ -1332,7 +1242,7 @@ class _Collected:
             duplicate = np.zeros(len(positions), dtype=bool)
         empty = np.empty(0)
         vessels = np.unique(positions["mmsi"].to_numpy())
-        datasets = [_dataset_reports(d, vessels) for d in self.datasets if vessels.size]
+        datasets = [_dataset_reports(d, vessels.tolist()) for d in self.datasets if vessels.size]
         counts = _sum_counts(
             [_report_rows(empty, empty, empty, empty), *self.dimension_parts, *datasets]
         )

@@ -33,6 +33,11 @@ CANONICAL_SCHEMA = pa.schema(
 
 CANONICAL_COLUMNS: tuple[str, ...] = tuple(CANONICAL_SCHEMA.names)
 
+# The vessel dimensions.
+DIMENSIONS: tuple[str, ...] = ("length_m", "breadth_m", "draught_m")
+# The columns of the positions the dimension statistics use: a dataset is read for these alone.
+STATS_POSITION_COLUMNS: tuple[str, ...] = ("mmsi", "ship_type", *DIMENSIONS)
+
 # ITU-R M.1371 navigational status codes.
 NAV_STATUS_CODES: dict[int, str] = {
     0: "Under way using engine",

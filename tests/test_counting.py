@@ -1,0 +1,172 @@
+"""Rows counted as they stream by (`ais.counting`), and a dataset counted for `stats`, on the
+caller's thread or ahead of it (`ais.dataset_count`)."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.compute as pc
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from colregs9_cli.ais import counting
+from colregs9_cli.ais.counting import RowCounts, row_runs
+from colregs9_cli.ais.dataset import ingest
+from colregs9_cli.ais.dataset_count import (
+    CountingAhead,
+    DatasetCounts,
+    count_ahead,
+    count_dataset,
+)
+from colregs9_cli.ais.dataset_scan import Dataset
+from colregs9_cli.errors import InputFileError
+from colregs9_cli.query import Query, Region, everything_query
+
+from fixture_files import DMA22, DMA26
+
+KEYS = ["mmsi", "ship_type", "length_m"]
+SCHEMA = pa.schema([("mmsi", pa.int64()), ("ship_type", pa.string()), ("length_m", pa.float64())])
+
+rows = st.lists(
+    st.tuples(
+        st.sampled_from([1, 2, 3]),
+        st.sampled_from([None, "Cargo", "Tanker"]),
+        st.sampled_from([None, 0.0, -0.0, float("nan"), 12.5, 200.0]),
+    ),
+    max_size=60,
+)
+
+
+def _table(values: list[tuple[int, str | None, float | None]]) -> pa.Table:
+    return pa.Table.from_pylist([dict(zip(KEYS, v, strict=True)) for v in values], SCHEMA)
+
+
+def _readable(table: pa.Table) -> list[tuple[str, ...]]:
+    """The rows as text: a NaN equals a NaN, and 0.0 is not -0.0."""
+    return sorted(tuple(repr(v) for v in row.values()) for row in table.to_pylist())
+
+
+def _grouped(table: pa.Table) -> list[tuple[str, ...]]:
+    counted = table.group_by(KEYS).aggregate([([], "count_all")])
+    return _readable(counted.rename_columns([*KEYS, "n"]))
+
+
+@settings(max_examples=150, deadline=None)
+@given(rows, st.lists(st.integers(1, 20), min_size=1, max_size=5), st.booleans(), st.integers(1, 8))
+def test_the_counts_are_those_of_arrows_grouping(
+    values: list[tuple[int, str | None, float | None]],
+    cuts: list[int],
+    in_runs: bool,
+    chunk_rows: int,
+) -> None:
+    """In whatever tables and batches the rows come, sorted into runs or not, and however
+    often the runs are grouped and merged, the counts are those of one grouping of all the
+    rows (nulls, NaN and the sign of zero told apart as it tells them)."""
+    if in_runs:
+        values = sorted(values, key=repr)
+    table = _table(values)
+    counts = RowCounts(KEYS, "n")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(counting, "COUNT_CHUNK_ROWS", chunk_rows)
+        patch.setattr(counting, "PARTS_BEFORE_MERGE", 2)
+        start = 0
+        for size in [*cuts, len(values)]:
+            counts.add(table.slice(start, size))
+            start += size
+        got = counts.finish()
+    assert _readable(got) == _grouped(table)
+    assert got.schema.field("n").type == pa.int64()
+    assert got.num_rows == 0 or got.column("mmsi").to_pylist() == sorted(
+        got.column("mmsi").to_pylist()
+    )
+
+
+def test_a_batch_in_runs_gives_one_row_a_run() -> None:
+    batch = _table(
+        [(1, "Cargo", 12.5)] * 3 + [(1, None, 12.5)] * 2 + [(2, None, None)] * 4 + [(2, None, -0.0)]
+    ).to_batches()[0]
+    runs = row_runs(batch, "n")
+    assert runs.to_pylist() == [
+        {"mmsi": 1, "ship_type": "Cargo", "length_m": 12.5, "n": 3},
+        {"mmsi": 1, "ship_type": None, "length_m": 12.5, "n": 2},
+        {"mmsi": 2, "ship_type": None, "length_m": None, "n": 4},
+        {"mmsi": 2, "ship_type": None, "length_m": -0.0, "n": 1},
+    ]
+
+
+def test_rows_that_change_at_every_row_are_kept_as_they_are() -> None:
+    """Rows in time order (the vessels interleaved) make a run of every row: counting their
+    runs would cost more than it saves, so each row stands for itself."""
+    batch = _table([(1 + i % 3, "Cargo", 12.5) for i in range(9)]).to_batches()[0]
+    runs = row_runs(batch, "n")
+    assert runs.num_rows == 9
+    assert runs.column("n").to_pylist() == [1] * 9
+    assert runs.drop_columns(["n"]).equals(pa.Table.from_batches([batch]))
+
+
+@pytest.fixture(scope="module")
+def two_day_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Two real samples without a date in common: a dataset without duplicates."""
+    out = tmp_path_factory.mktemp("counting") / "ais"
+    ingest([DMA26, DMA22], out, row_group_rows=700)
+    assert Dataset.open(out).duplicate_free
+    return out
+
+
+def _as_lists(counts: DatasetCounts) -> tuple[list[dict[str, object]], list[dict[str, object]]]:
+    return (counts.position_counts.to_pylist(), counts.report_counts.to_pylist())
+
+
+def test_a_query_of_everything_counts_as_a_query_that_selects_all(two_day_dataset: Path) -> None:
+    """A query of everything is counted in one scan; a region around the whole world, which
+    selects the same rows, in two (the positions, then the vessels' reports). They agree."""
+    dataset = Dataset.open(two_day_dataset)
+    everything = count_dataset(dataset, everything_query())
+    world = count_dataset(dataset, Query("world", region=Region(-90.0, 90.0, -180.0, 180.0)))
+    assert everything.position_counts.num_rows > 10
+    assert _as_lists(everything) == _as_lists(world)
+    positions = pc.sum(everything.position_counts.column("n_positions")).as_py()
+    assert positions == sum(f.rows for f in dataset.files) - dataset.static_rows
+
+
+def test_counting_ahead_gives_the_count(two_day_dataset: Path) -> None:
+    query = Query("region", region=Region(54.0, 58.0, 8.0, 13.0))
+    with count_ahead([two_day_dataset], query) as ahead:
+        assert ahead is not None
+        got = ahead.result()
+    assert _as_lists(got) == _as_lists(count_dataset(Dataset.open(two_day_dataset), query))
+
+
+def test_only_one_dataset_that_opens_is_counted_ahead(
+    tmp_path: Path, two_day_dataset: Path
+) -> None:
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "colregs9-dataset.json").write_text("{not json", encoding="utf-8")
+    for paths in ([DMA26], [two_day_dataset, DMA26], [tmp_path], [foreign]):
+        with count_ahead(paths, everything_query()) as ahead:
+            assert ahead is None, paths
+
+
+def test_an_error_while_counting_ahead_is_raised_to_the_caller(tmp_path: Path) -> None:
+    ingest([DMA22], tmp_path / "ais")
+    dataset = Dataset.open(tmp_path / "ais")
+    for file in (tmp_path / "ais").rglob("*.parquet"):  # damaged after it was checked
+        data = bytearray(file.read_bytes())
+        data[4:-8] = b"\xff" * len(data[4:-8])
+        file.write_bytes(bytes(data))
+    with (
+        CountingAhead(dataset, everything_query()) as ahead,
+        pytest.raises(InputFileError, match="cannot read the dataset"),
+    ):
+        ahead.result()
+
+
+def test_leaving_early_stops_the_count(two_day_dataset: Path) -> None:
+    with pytest.raises(KeyError), count_ahead([two_day_dataset], everything_query()) as ahead:
+        assert ahead is not None
+        raise KeyError("the caller failed")
+    assert not [t for t in threading.enumerate() if t.name == "colregs9-count-ahead"]
