@@ -3,8 +3,7 @@
 
 The first input starts being read before pandas and matplotlib are imported: their import
 takes about half a second on one core, and the CSV parse takes the other meanwhile
-(``ais.csv_read.start_reading``); a dataset read alone is counted meanwhile
-(``ais.dataset_count.count_ahead``). So this module imports them, and everything else the
+(``ais.csv_read.start_reading``). So this module imports them, and everything else the
 reading does not need (shapely, ``pyarrow.compute``), only inside ``run_stats``.
 """
 
@@ -71,16 +70,13 @@ def run_stats(
 
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
         check_out_dir(target, overwrite)
-        from .ais.dataset_count import count_ahead
+        from .ais.load import count_ais
+        from .dimensions import GroupBy, Per, dimension_stats
+        from .report.stats_report import build_manifest, format_text, write_stats_reports
 
-        with count_ahead(paths, query) as ahead:
-            from .ais.load import count_ais
-            from .dimensions import GroupBy, Per, dimension_stats
-            from .report.stats_report import build_manifest, format_text, write_stats_reports
-
-            per = _choice(Per, per, "--per")
-            by = None if by is None else _choice(GroupBy, by, "--by")
-            data = count_ais(paths, query=query, fmt=fmt, quiet=quiet, started=started, ahead=ahead)
+        per = _choice(Per, per, "--per")
+        by = None if by is None else _choice(GroupBy, by, "--by")
+        data = count_ais(paths, query=query, fmt=fmt, quiet=quiet, started=started)
     result = dimension_stats(data.position_counts, data.dimension_reports, per=per, by=by)
     manifest = build_manifest(result, query, data)
     files = write_stats_reports(target, result, query.name, manifest)

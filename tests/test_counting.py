@@ -1,9 +1,8 @@
-"""Rows counted as they stream by (`ais.counting`), and a dataset counted for `stats`, on the
-caller's thread or ahead of it (`ais.dataset_count`)."""
+"""Rows counted as they stream by (`ais.counting`), and a dataset counted for `stats` in one
+scan or two (`ais.dataset_count`)."""
 
 from __future__ import annotations
 
-import threading
 from pathlib import Path
 
 import pyarrow as pa
@@ -15,14 +14,8 @@ from hypothesis import strategies as st
 from colregs9_cli.ais import counting
 from colregs9_cli.ais.counting import RowCounts, row_runs
 from colregs9_cli.ais.dataset import ingest
-from colregs9_cli.ais.dataset_count import (
-    CountingAhead,
-    DatasetCounts,
-    count_ahead,
-    count_dataset,
-)
+from colregs9_cli.ais.dataset_count import DatasetCounts, count_dataset
 from colregs9_cli.ais.dataset_scan import Dataset
-from colregs9_cli.errors import InputFileError
 from colregs9_cli.query import Query, Region, everything_query
 
 from fixture_files import DMA22, DMA26
@@ -130,43 +123,3 @@ def test_a_query_of_everything_counts_as_a_query_that_selects_all(two_day_datase
     assert _as_lists(everything) == _as_lists(world)
     positions = pc.sum(everything.position_counts.column("n_positions")).as_py()
     assert positions == sum(f.rows for f in dataset.files) - dataset.static_rows
-
-
-def test_counting_ahead_gives_the_count(two_day_dataset: Path) -> None:
-    query = Query("region", region=Region(54.0, 58.0, 8.0, 13.0))
-    with count_ahead([two_day_dataset], query) as ahead:
-        assert ahead is not None
-        got = ahead.result()
-    assert _as_lists(got) == _as_lists(count_dataset(Dataset.open(two_day_dataset), query))
-
-
-def test_only_one_dataset_that_opens_is_counted_ahead(
-    tmp_path: Path, two_day_dataset: Path
-) -> None:
-    foreign = tmp_path / "foreign"
-    foreign.mkdir()
-    (foreign / "colregs9-dataset.json").write_text("{not json", encoding="utf-8")
-    for paths in ([DMA26], [two_day_dataset, DMA26], [tmp_path], [foreign]):
-        with count_ahead(paths, everything_query()) as ahead:
-            assert ahead is None, paths
-
-
-def test_an_error_while_counting_ahead_is_raised_to_the_caller(tmp_path: Path) -> None:
-    ingest([DMA22], tmp_path / "ais")
-    dataset = Dataset.open(tmp_path / "ais")
-    for file in (tmp_path / "ais").rglob("*.parquet"):  # damaged after it was checked
-        data = bytearray(file.read_bytes())
-        data[4:-8] = b"\xff" * len(data[4:-8])
-        file.write_bytes(bytes(data))
-    with (
-        CountingAhead(dataset, everything_query()) as ahead,
-        pytest.raises(InputFileError, match="cannot read the dataset"),
-    ):
-        ahead.result()
-
-
-def test_leaving_early_stops_the_count(two_day_dataset: Path) -> None:
-    with pytest.raises(KeyError), count_ahead([two_day_dataset], everything_query()) as ahead:
-        assert ahead is not None
-        raise KeyError("the caller failed")
-    assert not [t for t in threading.enumerate() if t.name == "colregs9-count-ahead"]

@@ -111,7 +111,6 @@ from .sources import (
 from .time_sources import IngestParams
 
 if TYPE_CHECKING:
-    from .dataset_count import CountingAhead
     from .dataset_scan import Dataset
 
 __all__ = [
@@ -265,23 +264,16 @@ def count_ais(
     fmt: str | None = None,
     quiet: bool = True,
     started: CsvReading | None = None,
-    ahead: CountingAhead | None = None,
 ) -> CountedAis:
     """What ``load_ais(..., needs_time=False)`` reads, with the positions counted by their
     MMSI, ship type and dimensions (``CountedAis``): what the dimension statistics need.
 
     One dataset read alone holds no duplicates (``_dataset_alone``): it is counted as it is
-    scanned (``dataset_count``), in memory set by the vessels, not by the rows; ``ahead`` is
-    that count already started (``dataset_count.count_ahead``) for ``paths`` and ``query``.
-    Other inputs are loaded whole, as duplicates across them are found among all their rows,
-    and then counted.
+    scanned (``dataset_count``), in memory set by the vessels, not by the rows. Other inputs
+    are loaded whole, as duplicates across them are found among all their rows, and then
+    counted.
     """
     query = query if query is not None else everything_query()
-    if ahead is not None:
-        assert ahead.query is query, "counted ahead for this query"
-        ingest_params(query)
-        check_format(fmt)
-        return _counted_dataset(ahead.dataset, query, quiet, ahead)
     sources = _open_inputs(paths, query, fmt)
     if not _dataset_alone(sources):
         counts = RowCounts(STATS_POSITION_COLUMNS, "n_positions")
@@ -296,18 +288,16 @@ def count_ais(
         )
     dataset = sources[0]
     assert not isinstance(dataset, Source), "_dataset_alone: a dataset"
-    return _counted_dataset(dataset, query, quiet, None)
+    return _counted_dataset(dataset, query, quiet)
 
 
-def _counted_dataset(
-    dataset: Dataset, query: Query, quiet: bool, ahead: CountingAhead | None
-) -> CountedAis:
+def _counted_dataset(dataset: Dataset, query: Query, quiet: bool) -> CountedAis:
     from .dataset_count import count_dataset
 
     with progress_bar(
         "Reading AIS", float(dataset.size_bytes), progress_enabled(quiet), in_bytes=True
     ) as bar:
-        counted = ahead.result() if ahead is not None else count_dataset(dataset, query)
+        counted = count_dataset(dataset, query)
         bar.advance(dataset.size_bytes)
     position_counts = counted.position_counts.to_pandas()
     kept = int(position_counts["n_positions"].sum())
