@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from colregs9_cli.ais import counting
+from colregs9_cli.ais import counting, load
 from colregs9_cli.ais.counting import RowCounts, row_runs
 from colregs9_cli.ais.dataset import ingest
 from colregs9_cli.ais.dataset_count import DatasetCounts, count_dataset
@@ -123,3 +123,34 @@ def test_a_query_of_everything_counts_as_a_query_that_selects_all(two_day_datase
     assert _as_lists(everything) == _as_lists(world)
     positions = pc.sum(everything.position_counts.column("n_positions")).as_py()
     assert positions == sum(f.rows for f in dataset.files) - dataset.static_rows
+
+
+duplicated_rows = st.lists(
+    st.tuples(
+        st.sampled_from([1, 2]),
+        st.sampled_from([None, 0, 1000]),
+        st.sampled_from([None, "Cargo", "Tanker"]),
+        st.sampled_from([None, float("nan"), 0.0, -0.0, 12.5]),
+    ),
+    max_size=40,
+)
+
+
+@settings(max_examples=150, deadline=None)
+@given(duplicated_rows)
+def test_repeated_rows_are_those_pandas_finds(
+    values: list[tuple[int, int | None, str | None, float | None]],
+) -> None:
+    """Sorted by MMSI and time, a row equal to an earlier one in every column is repeated,
+    as pandas' ``duplicated`` has it (a null equals a null or a NaN, -0.0 equals 0.0)."""
+    table = pa.table(
+        {
+            "mmsi": pa.array([v[0] for v in values], pa.int64()),
+            "timestamp": pa.array([v[1] for v in values], pa.timestamp("ms", tz="UTC")),
+            "ship_type": pa.array([v[2] for v in values], pa.string()),
+            "length_m": pa.array([v[3] for v in values], pa.float64()),
+        }
+    )
+    table = table.take(pc.sort_indices(table, sort_keys=load._ROW_ORDER))
+    want = table.to_pandas().duplicated(keep="first").to_numpy()
+    assert load._repeated_rows(table).tolist() == want.tolist()

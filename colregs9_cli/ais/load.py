@@ -133,6 +133,8 @@ _EXAMPLE_CHARS = 160
 _DECIMAL = re.compile(r"[-+]?\d+(\.\d*)?")
 # Convert the rows set aside once they hold this many bytes (see ``_FileResult.set_aside``).
 _SET_ASIDE_BYTES = 8 * 1024 * 1024
+# The order of the positions read, in which exact duplicates are found.
+_ROW_ORDER = [("mmsi", "ascending"), ("timestamp", "ascending")]
 
 
 @dataclass(frozen=True)
@@ -237,7 +239,7 @@ def _load(
             ledger.merge(part.ledger)
             collected.extend(part)
             inputs.append(InputFile(source.path, part.sha256, part.layout, part.ledger.rows_read))
-    positions, dimension_reports = collected.finish(ledger)
+    positions, dimension_reports = collected.finish(ledger, wanted)
     if positions.empty:
         raise no_positions_error(inputs, ledger, query)
     if list(positions.columns) != list(wanted):
@@ -1218,36 +1220,77 @@ class _Collected:
         if part.dimension_parts:
             self.dimension_parts.append(_sum_counts(part.dimension_parts))
 
-    def finish(self, ledger: RejectsLedger) -> tuple[pd.DataFrame, pd.DataFrame]:
-        """Sort, drop exact duplicates (ledger), and count the used rows."""
+    def finish(
+        self, ledger: RejectsLedger, wanted: Sequence[str]
+    ) -> tuple[pd.DataFrame, pd.DataFrame]:
+        """Sort, drop exact duplicates (ledger), and count the used rows; the positions with
+        the ``wanted`` columns. In Arrow: pandas would hold every column, text as objects."""
         table = pa.concat_tables(self.kept) if self.kept else CANONICAL_SCHEMA.empty_table()
-        positions = canonical_frame(table)
+        self.kept = []
         if self.ordered or self.may_repeat:
-            positions = positions.sort_values(
-                ["mmsi", "timestamp"], kind="stable", ignore_index=True
-            )
-        if self.may_repeat:
-            duplicate = positions.duplicated(keep="first").to_numpy()
-        else:
-            duplicate = np.zeros(len(positions), dtype=bool)
+            table = table.take(pc.sort_indices(table, sort_keys=_ROW_ORDER))
+        duplicate = _repeated_rows(table) if self.may_repeat else np.zeros(len(table), bool)
         empty = np.empty(0)
-        vessels = np.unique(positions["mmsi"].to_numpy())
-        datasets = [_dataset_reports(d, vessels.tolist()) for d in self.datasets if vessels.size]
+        vessels = pc.unique(table.column("mmsi")).to_pylist()
+        datasets = [_dataset_reports(d, vessels) for d in self.datasets if vessels]
         counts = _sum_counts(
             [_report_rows(empty, empty, empty, empty), *self.dimension_parts, *datasets]
         )
         if duplicate.any():
-            dropped = positions.loc[duplicate]
-            first = dropped.iloc[0]
+            dropped = table.filter(pa.array(duplicate))
+            first = canonical_frame(dropped.slice(0, 1).select(["mmsi", "timestamp"])).iloc[0]
             ledger.reject(
                 RejectReason.DUPLICATE,
-                int(duplicate.sum()),
+                len(dropped),
                 example=f"MMSI {first['mmsi']} at {first['timestamp']}: repeated row",
             )
             counts = _subtract_counts(counts, dropped)
-            positions = positions.loc[~duplicate].reset_index(drop=True)
-        ledger.use(len(positions))
-        return positions, _reports_frame(counts, np.unique(positions["mmsi"].to_numpy()))
+            table = table.filter(pa.array(~duplicate))
+        ledger.use(len(table))
+        positions = canonical_frame(table.select([c for c in wanted if c in table.column_names]))
+        return positions, _reports_frame(counts, pc.unique(table.column("mmsi")).to_numpy())
+
+
+def _repeated_rows(table: pa.Table) -> np.ndarray:
+    """The rows of ``table`` (sorted by ``_ROW_ORDER``) equal in every column to an earlier
+    row, as pandas' ``duplicated`` has it: a null equals a null or a NaN, and -0.0 equals
+    0.0. Such rows share their MMSI and time, so only the rows of a (MMSI, time) that
+    repeats are compared, with Arrow's hash grouping."""
+    rows = len(table)
+    repeated = np.zeros(rows, dtype=bool)
+    if rows < 2:
+        return repeated
+    same_as_next = np.ones(rows - 1, dtype=bool)
+    for name, _ in _ROW_ORDER:
+        column = table.column(name)
+        later, earlier = column.slice(1), column.slice(0, rows - 1)
+        same_as_next &= pc.coalesce(
+            pc.equal(later, earlier), pc.and_(later.is_null(), earlier.is_null())
+        ).to_numpy(zero_copy_only=False)
+    candidates = np.zeros(rows, dtype=bool)
+    candidates[1:] |= same_as_next
+    candidates[:-1] |= same_as_next
+    where = np.flatnonzero(candidates)
+    if where.size == 0:
+        return repeated
+    rows_of = table.take(pa.array(where))
+    keys = rows_of.column_names
+    for index, column in enumerate(rows_of.columns):
+        if pa.types.is_floating(column.type):
+            # Equal as pandas has it: NaN as null, -0.0 as 0.0 (adding 0.0 turns one into
+            # the other).
+            no_nan = pc.if_else(pc.is_nan(column), pa.scalar(None, column.type), column)
+            rows_of = rows_of.set_column(index, keys[index], pc.add(no_nan, 0.0))
+    firsts = (
+        rows_of.append_column("row", pa.array(where, pa.int64()))
+        .group_by(keys, use_threads=False)
+        .aggregate([("row", "min")])
+        .column("row_min")
+        .to_numpy()
+    )
+    repeated[where] = True
+    repeated[firsts] = False
+    return repeated
 
 
 def _reports_frame(counts: pa.Table, vessels: np.ndarray) -> pd.DataFrame:
@@ -1259,14 +1302,18 @@ def _reports_frame(counts: pa.Table, vessels: np.ndarray) -> pd.DataFrame:
     return reports[list(DIMENSION_REPORT_COLUMNS)]
 
 
-def _subtract_counts(counts: pa.Table, dropped: pd.DataFrame) -> pa.Table:
-    frame = dropped[["mmsi", *DIMENSIONS]].astype({d: np.float64 for d in DIMENSIONS})
-    frame = frame[frame[list(DIMENSIONS)].notna().any(axis=1)]
-    if frame.empty:
+def _subtract_counts(counts: pa.Table, dropped: pa.Table) -> pa.Table:
+    """``counts`` less the dimension reports of the ``dropped`` rows."""
+    length_m, breadth_m, draught_m = (to_numpy_float(dropped.column(d)) for d in DIMENSIONS)
+    reported = any_dimension(length_m, breadth_m, draught_m)
+    if not reported.any():
         return counts
-    length_m, breadth_m, draught_m = (frame[dimension].to_numpy() for dimension in DIMENSIONS)
     removed = _report_rows(
-        frame["mmsi"].to_numpy(), length_m, breadth_m, draught_m, times=np.full(len(frame), -1)
+        dropped.column("mmsi").to_numpy()[reported],
+        length_m[reported],
+        breadth_m[reported],
+        draught_m[reported],
+        times=np.full(int(reported.sum()), -1),
     )
     return _sum_counts([counts, removed])
 
