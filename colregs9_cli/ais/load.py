@@ -1224,12 +1224,14 @@ class _Collected:
         self, ledger: RejectsLedger, wanted: Sequence[str]
     ) -> tuple[pd.DataFrame, pd.DataFrame]:
         """Sort, drop exact duplicates (ledger), and count the used rows; the positions with
-        the ``wanted`` columns. In Arrow: pandas would hold every column, text as objects."""
+        the ``wanted`` columns. In Arrow, and without a sorted copy of every column: pandas
+        would hold every column, text as objects."""
         table = pa.concat_tables(self.kept) if self.kept else CANONICAL_SCHEMA.empty_table()
         self.kept = []
+        rows = np.arange(len(table))
         if self.ordered or self.may_repeat:
-            table = table.take(pc.sort_indices(table, sort_keys=_ROW_ORDER))
-        duplicate = _repeated_rows(table) if self.may_repeat else np.zeros(len(table), bool)
+            rows = pc.sort_indices(table.select(["mmsi", "timestamp"]), _ROW_ORDER).to_numpy()
+        duplicate = _repeated_rows(table, rows) if self.may_repeat else np.zeros(len(rows), bool)
         empty = np.empty(0)
         vessels = pc.unique(table.column("mmsi")).to_pylist()
         datasets = [_dataset_reports(d, vessels) for d in self.datasets if vessels]
@@ -1237,7 +1239,7 @@ class _Collected:
             [_report_rows(empty, empty, empty, empty), *self.dimension_parts, *datasets]
         )
         if duplicate.any():
-            dropped = table.filter(pa.array(duplicate))
+            dropped = table.select(["mmsi", "timestamp", *DIMENSIONS]).take(rows[duplicate])
             first = canonical_frame(dropped.slice(0, 1).select(["mmsi", "timestamp"])).iloc[0]
             ledger.reject(
                 RejectReason.DUPLICATE,
@@ -1245,24 +1247,25 @@ class _Collected:
                 example=f"MMSI {first['mmsi']} at {first['timestamp']}: repeated row",
             )
             counts = _subtract_counts(counts, dropped)
-            table = table.filter(pa.array(~duplicate))
-        ledger.use(len(table))
-        positions = canonical_frame(table.select([c for c in wanted if c in table.column_names]))
-        return positions, _reports_frame(counts, pc.unique(table.column("mmsi")).to_numpy())
+            rows = rows[~duplicate]
+        ledger.use(len(rows))
+        positions = table.select([c for c in wanted if c in table.column_names]).take(rows)
+        vessels_used = np.unique(positions.column("mmsi").to_numpy())
+        return canonical_frame(positions), _reports_frame(counts, vessels_used)
 
 
-def _repeated_rows(table: pa.Table) -> np.ndarray:
-    """The rows of ``table`` (sorted by ``_ROW_ORDER``) equal in every column to an earlier
-    row, as pandas' ``duplicated`` has it: a null equals a null or a NaN, and -0.0 equals
-    0.0. Such rows share their MMSI and time, so only the rows of a (MMSI, time) that
-    repeats are compared, with Arrow's hash grouping."""
-    rows = len(table)
+def _repeated_rows(table: pa.Table, order: np.ndarray) -> np.ndarray:
+    """Which rows of ``table`` taken in ``order`` (sorted by ``_ROW_ORDER``) are equal in
+    every column to an earlier one, as pandas' ``duplicated`` has it: a null equals a null
+    or a NaN, and -0.0 equals 0.0. Such rows share their MMSI and time, so only the rows of
+    a (MMSI, time) that repeats are compared, with Arrow's hash grouping."""
+    rows = len(order)
     repeated = np.zeros(rows, dtype=bool)
     if rows < 2:
         return repeated
     same_as_next = np.ones(rows - 1, dtype=bool)
     for name, _ in _ROW_ORDER:
-        column = table.column(name)
+        column = table.column(name).take(order)
         later, earlier = column.slice(1), column.slice(0, rows - 1)
         same_as_next &= pc.coalesce(
             pc.equal(later, earlier), pc.and_(later.is_null(), earlier.is_null())
@@ -1273,7 +1276,7 @@ def _repeated_rows(table: pa.Table) -> np.ndarray:
     where = np.flatnonzero(candidates)
     if where.size == 0:
         return repeated
-    rows_of = table.take(pa.array(where))
+    rows_of = table.take(order[where])
     keys = rows_of.column_names
     for index, column in enumerate(rows_of.columns):
         if pa.types.is_floating(column.type):
