@@ -5,17 +5,23 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from typer.testing import CliRunner
 
-from colregs9_cli.ais import counting, load
+from colregs9_cli.ais import counting
 from colregs9_cli.ais.counting import RowCounts, row_runs
-from colregs9_cli.ais.dataset import ingest
+from colregs9_cli.ais.dataset import ingest, ingest_with_query
 from colregs9_cli.ais.dataset_count import DatasetCounts, count_dataset
 from colregs9_cli.ais.dataset_scan import Dataset
+from colregs9_cli.ais.duplicates import ROW_ORDER, repeated_rows
+from colregs9_cli.ais.load import count_ais, load_ais
+from colregs9_cli.cli import app
+from colregs9_cli.errors import NoDataError
 from colregs9_cli.query import Query, Region, everything_query
 
 from fixture_files import DMA22, DMA26
@@ -61,7 +67,7 @@ def test_the_counts_are_those_of_arrows_grouping(
     if in_runs:
         values = sorted(values, key=repr)
     table = _table(values)
-    counts = RowCounts(KEYS, "n")
+    counts = RowCounts(SCHEMA, "n")
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(counting, "COUNT_CHUNK_ROWS", chunk_rows)
         patch.setattr(counting, "PARTS_BEFORE_MERGE", 2)
@@ -75,6 +81,12 @@ def test_the_counts_are_those_of_arrows_grouping(
     assert got.num_rows == 0 or got.column("mmsi").to_pylist() == sorted(
         got.column("mmsi").to_pylist()
     )
+
+
+def test_nothing_counted_gives_an_empty_table_of_the_key_types() -> None:
+    got = RowCounts(SCHEMA, "n").finish()
+    assert got.num_rows == 0
+    assert got.schema == pa.schema([*SCHEMA, pa.field("n", pa.int64())])
 
 
 def test_a_batch_in_runs_gives_one_row_a_run() -> None:
@@ -151,6 +163,36 @@ def test_repeated_rows_are_those_pandas_finds(
             "length_m": pa.array([v[3] for v in values], pa.float64()),
         }
     )
-    order = pc.sort_indices(table, sort_keys=load._ROW_ORDER).to_numpy()
+    order = pc.sort_indices(table, sort_keys=ROW_ORDER).to_numpy()
     want = table.take(order).to_pandas().duplicated(keep="first").to_numpy()
-    assert load._repeated_rows(table, order).tolist() == want.tolist()
+    assert repeated_rows(table, order).tolist() == want.tolist()
+
+
+def test_an_empty_dataset_selects_no_positions(tmp_path: Path) -> None:
+    """A dataset of no row (its input's rows all outside the ingest query) is counted empty
+    in one scan or two; `stats` says the query selects no position (exit 3)."""
+    lines = DMA26.read_text(encoding="utf-8").splitlines(keepends=True)
+    positioned = tmp_path / "positioned.csv"  # no static report: each row has a position
+    positioned.write_text("".join(line for line in lines if ",91,0," not in line))
+    nowhere = Query("nowhere", region=Region(-10.0, -9.0, -10.0, -9.0))
+    ingest_with_query([positioned], tmp_path / "ais", nowhere)
+    dataset = Dataset.open(tmp_path / "ais")
+    assert dataset.rows == 0
+    for query in (everything_query(), Query("world", region=Region(-90.0, 90.0, -180.0, 180.0))):
+        counts = count_dataset(dataset, query)
+        assert counts.position_counts.num_rows == counts.report_counts.num_rows == 0
+        with pytest.raises(NoDataError, match="selects no vessel positions"):
+            count_ais([tmp_path / "ais"], query)
+    result = CliRunner().invoke(app, ["stats", str(tmp_path / "ais"), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 3, result.output
+    assert result.output.startswith("Error: ")
+
+
+@pytest.mark.parametrize("columns", [["lat_deg", "lon_deg"], ["timestamp", "sog_kn"]])
+def test_positions_may_be_read_without_their_mmsi(columns: list[str]) -> None:
+    """Files read whole (duplicates sought across them) give the columns asked for, in
+    that order, the MMSI among them or not."""
+    whole = load_ais([DMA26, DMA22])
+    got = load_ais([DMA26, DMA22], columns=columns)
+    assert list(got.positions.columns) == columns
+    pd.testing.assert_frame_equal(got.positions, whole.positions[columns])

@@ -2,10 +2,10 @@
 in memory set by the distinct values, not by the rows: what ``colregs9 stats`` keeps of the
 positions (their MMSI, ship type and dimensions) and of the dimension reports.
 
-The rows come sorted by vessel and time (a dataset's files, a file's positions), so
-consecutive rows mostly carry the same values. Each table is first cut into its runs of
-equal rows: the run ends of Arrow's run-end encoding of each column, taken together, are
-those of the rows. There are few runs (37 thousand for the 7 million positions of the
+The rows mostly come in runs of a vessel (a dataset's files are sorted by hour, cell,
+vessel and time), so consecutive rows mostly carry the same values. Each table is first cut
+into its runs of equal rows: the run ends of Arrow's run-end encoding of each column, taken
+together, are those of the rows. There are few runs (37 thousand for the 7 million positions of the
 national day), and Arrow's hash grouping then sums them. Equal means what the grouping
 means: a null equals a null, a NaN a NaN, and 0.0 is not -0.0. Rows in any order are
 counted right; where the runs would be more than half the rows, the rows are grouped as
@@ -19,8 +19,6 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from .schema import CANONICAL_SCHEMA
-
 # Runs grouped at once: a grouping costs per call, and the runs waiting bound memory.
 COUNT_CHUNK_ROWS = 1 << 20
 # Merge the grouped chunks once this many have piled up.
@@ -28,11 +26,13 @@ PARTS_BEFORE_MERGE = 64
 
 
 class RowCounts:
-    """How many of the rows added have each distinct combination of ``keys`` (canonical
-    columns), in the column ``name``."""
+    """How many of the rows added have each distinct combination of the columns of
+    ``keys``, in the column ``name``; ``keys`` also gives the types of the result when no
+    row was added."""
 
-    def __init__(self, keys: Sequence[str], name: str) -> None:
-        self.keys, self.name = list(keys), name
+    def __init__(self, keys: pa.Schema, name: str) -> None:
+        self.keys, self.name = list(keys.names), name
+        self._empty = pa.schema([*keys, pa.field(name, pa.int64())]).empty_table()
         self._runs: list[pa.Table] = []
         self._run_rows = 0
         self._counted: list[pa.Table] = []
@@ -57,12 +57,7 @@ class RowCounts:
         """The counts, one row per combination, sorted by the keys."""
         self._count_runs()
         if not self._counted:
-            return pa.table(
-                {
-                    **{k: pa.array([], CANONICAL_SCHEMA.field(k).type) for k in self.keys},
-                    self.name: pa.array([], pa.int64()),
-                }
-            )
+            return self._empty
         summed = sum_by(self._counted, self.keys, self.name)
         return summed.sort_by([(key, "ascending") for key in self.keys])
 

@@ -3,7 +3,7 @@
 ``CsvReading`` opens the file (decompressing and hashing it, see sources.py) and gives its
 chunks (see csv_chunks.py). ``start_reading`` opens the first input of a run ahead of time:
 a thread reads and parses its first chunks into a queue while the caller imports the
-libraries of the analysis (pandas and matplotlib take about a second, on one core, which
+libraries of the analysis (pandas and matplotlib take about half a second, on one core, which
 would leave the other idle). This module and the ones it imports need only pyarrow and
 numpy.
 """

@@ -74,6 +74,7 @@ from .dataset_scan import (
     scan_columns,
     utc_ms,
 )
+from .duplicates import repeated_rows
 from .ledger import RejectReason, RejectsLedger
 from .load import (
     InputFile,
@@ -475,23 +476,9 @@ def _drop_duplicates(table: pa.Table) -> tuple[pa.Table, pa.Table]:
     """``table`` without rows equal in every column to an earlier one, and the rows dropped.
 
     Equal rows share their (mmsi, timestamp), and ``table`` must have those rows next to
-    each other (as both sorts here do); only runs of such rows are compared whole, with
-    pandas' equality as ``load_ais`` uses (NaN equals NaN).
+    each other (as both sorts here do): ``duplicates.repeated_rows`` compares only those.
     """
-    if table.num_rows < 2:
-        return table, table.slice(0, 0)
-    mmsi = table.column("mmsi").to_numpy()
-    stamps = table.column("timestamp").cast(pa.int64()).to_numpy()
-    same = (mmsi[1:] == mmsi[:-1]) & (stamps[1:] == stamps[:-1])
-    in_run = np.zeros(table.num_rows, dtype=bool)
-    in_run[1:] |= same
-    in_run[:-1] |= same
-    candidates = np.flatnonzero(in_run)
-    if candidates.size == 0:
-        return table, table.slice(0, 0)
-    repeated = table.take(pa.array(candidates)).to_pandas().duplicated(keep="first").to_numpy()
-    dropped = np.zeros(table.num_rows, dtype=bool)
-    dropped[candidates[repeated]] = True
+    dropped = repeated_rows(table, np.arange(table.num_rows))
     return table.filter(pa.array(~dropped)), table.filter(pa.array(dropped))
 
 

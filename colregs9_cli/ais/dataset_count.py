@@ -26,7 +26,7 @@ from .dataset_scan import (
     reports_filter,
     scan_columns,
 )
-from .schema import CANONICAL_COLUMNS, DIMENSIONS, STATS_POSITION_COLUMNS
+from .schema import CANONICAL_COLUMNS, DIMENSIONS, STATS_POSITION_COLUMNS, canonical_fields
 
 REPORT_COLUMNS: tuple[str, ...] = ("mmsi", *DIMENSIONS)
 # The flag of the rows with a position, in a query of everything.
@@ -51,7 +51,7 @@ def count_dataset(dataset: Dataset, query: Query) -> DatasetCounts:
     """Count the positions of ``dataset`` in ``query`` and the rows of the vessels found."""
     if query.region is None and query.time.unbounded and query.vessels.selects_all:
         return _count_everything(dataset)
-    positions = RowCounts(STATS_POSITION_COLUMNS, "n_positions")
+    positions = RowCounts(canonical_fields(STATS_POSITION_COLUMNS), "n_positions")
     scanned = scan_columns(STATS_POSITION_COLUMNS, query, ordered=False)
     for table in positions_in_query(dataset, query, scanned, position_filter(query)):
         positions.add(table)
@@ -63,7 +63,7 @@ def count_dataset(dataset: Dataset, query: Query) -> DatasetCounts:
 def count_reports(dataset: Dataset, vessels: Sequence[int]) -> pa.Table:
     """``DatasetCounts.report_counts`` of ``vessels``: every row of theirs, positions and
     static reports, at any time and place, counted by ``REPORT_COLUMNS``."""
-    reports = RowCounts(REPORT_COLUMNS, "n_reports")
+    reports = RowCounts(canonical_fields(REPORT_COLUMNS), "n_reports")
     if len(vessels):
         for table in dataset.scan(reports_filter(vessels), REPORT_COLUMNS):
             reports.add(table)
@@ -74,7 +74,8 @@ def _count_everything(dataset: Dataset) -> DatasetCounts:
     """``count_dataset`` for a query of everything, in one scan."""
     keys = [c for c in CANONICAL_COLUMNS if c in {*STATS_POSITION_COLUMNS, *REPORT_COLUMNS}]
     scanned = [c for c in CANONICAL_COLUMNS if c in {*keys, "lat_deg", "lon_deg"}]
-    rows = RowCounts([*keys, _HAS_POSITION], "n")
+    flagged = canonical_fields(keys).append(pa.field(_HAS_POSITION, pa.bool_()))
+    rows = RowCounts(flagged, "n")
     for table in dataset.scan(pc.scalar(True), scanned):
         # A position as the pushdown has it (``position_filter``).
         has_position = pc.and_(

@@ -96,9 +96,16 @@ from .counting import PARTS_BEFORE_MERGE, RowCounts, sum_by
 from .csv_chunks import CsvChunk, CutRows, NotUtf8, ParsedRows, parse_cut_rows
 from .csv_read import CsvReading, missing_columns
 from .detect import LAYOUTS, csv_header, detect_layout, is_csv_layout, known_layout
+from .duplicates import ROW_ORDER, repeated_rows
 from .ledger import DropReason, RejectReason, RejectsLedger
 from .query_rows import rows_in_window_and_filter
-from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA, DIMENSIONS, STATS_POSITION_COLUMNS
+from .schema import (
+    CANONICAL_COLUMNS,
+    CANONICAL_SCHEMA,
+    DIMENSIONS,
+    STATS_POSITION_COLUMNS,
+    canonical_fields,
+)
 from .sources import (
     Source,
     decompression_error,
@@ -133,8 +140,6 @@ _EXAMPLE_CHARS = 160
 _DECIMAL = re.compile(r"[-+]?\d+(\.\d*)?")
 # Convert the rows set aside once they hold this many bytes (see ``_FileResult.set_aside``).
 _SET_ASIDE_BYTES = 8 * 1024 * 1024
-# The order of the positions read, in which exact duplicates are found.
-_ROW_ORDER = [("mmsi", "ascending"), ("timestamp", "ascending")]
 
 
 @dataclass(frozen=True)
@@ -278,7 +283,7 @@ def count_ais(
     query = query if query is not None else everything_query()
     sources = _open_inputs(paths, query, fmt)
     if not _dataset_alone(sources):
-        counts = RowCounts(STATS_POSITION_COLUMNS, "n_positions")
+        counts = RowCounts(canonical_fields(STATS_POSITION_COLUMNS), "n_positions")
         data = _load(sources, query, fmt, quiet, started, STATS_POSITION_COLUMNS, False, False)
         counts.add(pa.Table.from_pandas(data.positions, preserve_index=False))
         return CountedAis(
@@ -1224,14 +1229,18 @@ class _Collected:
         self, ledger: RejectsLedger, wanted: Sequence[str]
     ) -> tuple[pd.DataFrame, pd.DataFrame]:
         """Sort, drop exact duplicates (ledger), and count the used rows; the positions with
-        the ``wanted`` columns. In Arrow, and without a sorted copy of every column: pandas
-        would hold every column, text as objects."""
+        the ``wanted`` columns. In Arrow, and without a sorted copy of every column: the
+        rows are held for the duplicates, but only the wanted columns go to pandas."""
         table = pa.concat_tables(self.kept) if self.kept else CANONICAL_SCHEMA.empty_table()
         self.kept = []
+        # Text columns as large strings: a take joins a column's chunks, and a string
+        # column's offsets end at 2 GiB.
+        table = table.cast(_large_text(table.schema))
         rows = np.arange(len(table))
-        if self.ordered or self.may_repeat:
-            rows = pc.sort_indices(table.select(["mmsi", "timestamp"]), _ROW_ORDER).to_numpy()
-        duplicate = _repeated_rows(table, rows) if self.may_repeat else np.zeros(len(rows), bool)
+        reordered = self.ordered or self.may_repeat
+        if reordered:
+            rows = pc.sort_indices(table.select(["mmsi", "timestamp"]), ROW_ORDER).to_numpy()
+        duplicate = repeated_rows(table, rows) if self.may_repeat else np.zeros(len(rows), bool)
         empty = np.empty(0)
         vessels = pc.unique(table.column("mmsi")).to_pylist()
         datasets = [_dataset_reports(d, vessels) for d in self.datasets if vessels]
@@ -1249,51 +1258,17 @@ class _Collected:
             counts = _subtract_counts(counts, dropped)
             rows = rows[~duplicate]
         ledger.use(len(rows))
-        positions = table.select([c for c in wanted if c in table.column_names]).take(rows)
-        vessels_used = np.unique(positions.column("mmsi").to_numpy())
+        positions = table.select([c for c in wanted if c in table.column_names])
+        if reordered:
+            positions = positions.take(rows)
+        vessels_used = np.unique(table.column("mmsi").take(rows).to_numpy())
         return canonical_frame(positions), _reports_frame(counts, vessels_used)
 
 
-def _repeated_rows(table: pa.Table, order: np.ndarray) -> np.ndarray:
-    """Which rows of ``table`` taken in ``order`` (sorted by ``_ROW_ORDER``) are equal in
-    every column to an earlier one, as pandas' ``duplicated`` has it: a null equals a null
-    or a NaN, and -0.0 equals 0.0. Such rows share their MMSI and time, so only the rows of
-    a (MMSI, time) that repeats are compared, with Arrow's hash grouping."""
-    rows = len(order)
-    repeated = np.zeros(rows, dtype=bool)
-    if rows < 2:
-        return repeated
-    same_as_next = np.ones(rows - 1, dtype=bool)
-    for name, _ in _ROW_ORDER:
-        column = table.column(name).take(order)
-        later, earlier = column.slice(1), column.slice(0, rows - 1)
-        same_as_next &= pc.coalesce(
-            pc.equal(later, earlier), pc.and_(later.is_null(), earlier.is_null())
-        ).to_numpy(zero_copy_only=False)
-    candidates = np.zeros(rows, dtype=bool)
-    candidates[1:] |= same_as_next
-    candidates[:-1] |= same_as_next
-    where = np.flatnonzero(candidates)
-    if where.size == 0:
-        return repeated
-    rows_of = table.take(order[where])
-    keys = rows_of.column_names
-    for index, column in enumerate(rows_of.columns):
-        if pa.types.is_floating(column.type):
-            # Equal as pandas has it: NaN as null, -0.0 as 0.0 (adding 0.0 turns one into
-            # the other).
-            no_nan = pc.if_else(pc.is_nan(column), pa.scalar(None, column.type), column)
-            rows_of = rows_of.set_column(index, keys[index], pc.add(no_nan, 0.0))
-    firsts = (
-        rows_of.append_column("row", pa.array(where, pa.int64()))
-        .group_by(keys, use_threads=False)
-        .aggregate([("row", "min")])
-        .column("row_min")
-        .to_numpy()
+def _large_text(schema: pa.Schema) -> pa.Schema:
+    return pa.schema(
+        [f.with_type(pa.large_string()) if pa.types.is_string(f.type) else f for f in schema]
     )
-    repeated[where] = True
-    repeated[firsts] = False
-    return repeated
 
 
 def _reports_frame(counts: pa.Table, vessels: np.ndarray) -> pd.DataFrame:
@@ -1325,7 +1300,8 @@ def canonical_frame(table: pa.Table) -> pd.DataFrame:
     """Canonical columns (those of ``table``, in canonical order): int64 MMSI, nullable
     Int8/Int64 for status and IMO, NaN floats."""
     frame = table.to_pandas()
-    frame["mmsi"] = frame["mmsi"].astype(np.int64)
+    if "mmsi" in frame.columns:
+        frame["mmsi"] = frame["mmsi"].astype(np.int64)
     if "timestamp" in frame.columns:
         frame["timestamp"] = pd.to_datetime(frame["timestamp"], utc=True)
     for name, dtype in (("nav_status", "Int8"), ("imo", "Int64")):

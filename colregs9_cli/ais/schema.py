@@ -7,6 +7,8 @@ turned into nulls by the readers and nowhere else.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import pyarrow as pa
 
 CANONICAL_SCHEMA = pa.schema(
@@ -37,6 +39,12 @@ CANONICAL_COLUMNS: tuple[str, ...] = tuple(CANONICAL_SCHEMA.names)
 DIMENSIONS: tuple[str, ...] = ("length_m", "breadth_m", "draught_m")
 # The columns of the positions the dimension statistics use: a dataset is read for these alone.
 STATS_POSITION_COLUMNS: tuple[str, ...] = ("mmsi", "ship_type", *DIMENSIONS)
+
+
+def canonical_fields(names: Iterable[str]) -> pa.Schema:
+    """The canonical fields of ``names``, in that order."""
+    return pa.schema([CANONICAL_SCHEMA.field(name) for name in names])
+
 
 # ITU-R M.1371 navigational status codes.
 NAV_STATUS_CODES: dict[int, str] = {
