@@ -74,7 +74,7 @@ from .dataset_scan import (
     scan_columns,
     utc_ms,
 )
-from .duplicates import repeated_rows
+from .duplicates import ROW_ORDER, repeated_rows
 from .ledger import RejectReason, RejectsLedger
 from .load import (
     InputFile,
@@ -603,7 +603,7 @@ def read_window_counted(
     tables = list(positions_in_query(dataset, query, read, expression))
     schema = pa.schema([CANONICAL_SCHEMA.field(name) for name in read])
     table = pa.concat_tables(tables) if tables else schema.empty_table()
-    order = pc.sort_indices(table, sort_keys=[("mmsi", "ascending"), ("timestamp", "ascending")])
+    order = pc.sort_indices(table, sort_keys=ROW_ORDER)
     table = table.take(order)
     dropped = table.slice(0, 0)
     if not dataset.duplicate_free:

@@ -200,7 +200,13 @@ def load_ais(
     if not set(wanted) <= set(CANONICAL_COLUMNS):
         raise ParameterError(f"columns {wanted}: give canonical columns ({CANONICAL_COLUMNS})")
     sources = _open_inputs(paths, query, fmt)
-    return _load(sources, query, fmt, quiet, started, wanted, ordered, needs_time)
+    read = _load(sources, query, fmt, quiet, started, wanted, ordered, needs_time)
+    positions = canonical_frame(read.positions)
+    if list(positions.columns) != wanted:
+        positions = positions[wanted]
+    return AisData(
+        positions, read.dimension_reports, read.ledger, read.inputs, read.positions.num_rows
+    )
 
 
 def _open_inputs(paths: Sequence[Path], query: Query, fmt: str | None) -> list[Source | Dataset]:
@@ -220,7 +226,7 @@ def _load(
     wanted: Sequence[str],
     ordered: bool,
     needs_time: bool,
-) -> AisData:
+) -> _Read:
     ledger = RejectsLedger()
     collected = _Collected(may_repeat=not _dataset_alone(sources), ordered=ordered)
     scanned: Sequence[str] = CANONICAL_COLUMNS
@@ -245,11 +251,19 @@ def _load(
             collected.extend(part)
             inputs.append(InputFile(source.path, part.sha256, part.layout, part.ledger.rows_read))
     positions, dimension_reports = collected.finish(ledger, wanted)
-    if positions.empty:
+    if positions.num_rows == 0:
         raise no_positions_error(inputs, ledger, query)
-    if list(positions.columns) != list(wanted):
-        positions = positions[list(wanted)]
-    return AisData(positions, dimension_reports, ledger, tuple(inputs), len(positions))
+    return _Read(positions, dimension_reports, ledger, tuple(inputs))
+
+
+@dataclass(frozen=True)
+class _Read:
+    """What ``_load`` read: ``AisData`` with the positions still an Arrow table."""
+
+    positions: pa.Table
+    dimension_reports: pd.DataFrame
+    ledger: RejectsLedger
+    inputs: tuple[InputFile, ...]
 
 
 @dataclass(frozen=True)
@@ -284,14 +298,14 @@ def count_ais(
     sources = _open_inputs(paths, query, fmt)
     if not _dataset_alone(sources):
         counts = RowCounts(canonical_fields(STATS_POSITION_COLUMNS), "n_positions")
-        data = _load(sources, query, fmt, quiet, started, STATS_POSITION_COLUMNS, False, False)
-        counts.add(pa.Table.from_pandas(data.positions, preserve_index=False))
+        read = _load(sources, query, fmt, quiet, started, STATS_POSITION_COLUMNS, False, False)
+        counts.add(read.positions)
         return CountedAis(
             counts.finish().to_pandas(),
-            data.dimension_reports,
-            data.ledger,
-            data.inputs,
-            data.rows_in_query,
+            read.dimension_reports,
+            read.ledger,
+            read.inputs,
+            read.positions.num_rows,
         )
     dataset = sources[0]
     assert not isinstance(dataset, Source), "_dataset_alone: a dataset"
@@ -1225,12 +1239,10 @@ class _Collected:
         if part.dimension_parts:
             self.dimension_parts.append(_sum_counts(part.dimension_parts))
 
-    def finish(
-        self, ledger: RejectsLedger, wanted: Sequence[str]
-    ) -> tuple[pd.DataFrame, pd.DataFrame]:
+    def finish(self, ledger: RejectsLedger, wanted: Sequence[str]) -> tuple[pa.Table, pd.DataFrame]:
         """Sort, drop exact duplicates (ledger), and count the used rows; the positions with
         the ``wanted`` columns. In Arrow, and without a sorted copy of every column: the
-        rows are held for the duplicates, but only the wanted columns go to pandas."""
+        rows are held for the duplicates, but only the wanted columns are taken."""
         table = pa.concat_tables(self.kept) if self.kept else CANONICAL_SCHEMA.empty_table()
         self.kept = []
         # Text columns as large strings: a take joins a column's chunks, and a string
@@ -1258,11 +1270,11 @@ class _Collected:
             counts = _subtract_counts(counts, dropped)
             rows = rows[~duplicate]
         ledger.use(len(rows))
-        positions = table.select([c for c in wanted if c in table.column_names])
+        positions = table.select(list(wanted))
         if reordered:
             positions = positions.take(rows)
         vessels_used = np.unique(table.column("mmsi").take(rows).to_numpy())
-        return canonical_frame(positions), _reports_frame(counts, vessels_used)
+        return positions, _reports_frame(counts, vessels_used)
 
 
 def _large_text(schema: pa.Schema) -> pa.Schema:
