@@ -612,6 +612,14 @@ def _read_features(path: Path) -> _Features:
             f"{path}: the chart has no depth areas (DEPARE or DRGARE polygons); give a chart "
             "with depth information"
         )
+    unknown = depth & polygonal & np.isnan(features.drval1_m)
+    if unknown.any():
+        # A depth area of unknown depth would be read as too shallow for every vessel.
+        raise ChartError(
+            f"{path}: {int(unknown.sum())} of {int((depth & polygonal).sum())} depth areas have "
+            "no DRVAL1 (their least depth); give each depth area its DRVAL1 in metres, or "
+            "leave out those of unknown depth"
+        )
     return features
 
 
@@ -648,6 +656,8 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
             "pass --accept-chart-gaps to use the cell as updated up to the gap"
         )
     fields = _dsid_fields(path)
+    _check_updates_applied(path, updates, missing, _whole_number(fields.get("DSID_UPDN")))
+    _check_depth_unit(path, fields.get("DSPM_DUNI"))
     issue = fields.get("DSID_ISDT")
     return CellInfo(
         path=path,
@@ -660,6 +670,39 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
         purpose=cell_purpose(fields.get("DSID_INTU"), path),
         scale=_whole_number(fields.get("DSPM_CSCL")),
     )
+
+
+def _check_updates_applied(
+    path: Path, updates: Sequence[Path], missing: Sequence[str], update_number: int | None
+) -> None:
+    """GDAL skips an update it cannot apply (corrupt, or of another edition) without a word;
+    the cell's update number after reading tells."""
+    first_gap = min((int(name.rsplit(".", 1)[1]) for name in missing), default=None)
+    before_gap = [u for u in updates if first_gap is None or int(u.suffix[1:]) < first_gap]
+    if not before_gap:
+        return
+    expected = int(before_gap[-1].suffix[1:])
+    if update_number is None or update_number < expected:
+        applied = f"up to .{update_number:03d}" if update_number else "none"
+        raise ChartError(
+            f"{path}: of the update files {before_gap[0].name} to {before_gap[-1].name} beside "
+            f"it GDAL applied {applied}: .{(update_number or 0) + 1:03d} could not be applied "
+            "(corrupt, or of another edition of the cell). Replace the update files with those "
+            "of this edition, or move them away to use the base cell alone"
+        )
+
+
+# S-57 depth units (DSPM DUNI); ENCs must give metres.
+_DEPTH_UNITS = {1: "metres", 2: "fathoms and feet", 3: "feet", 4: "fathoms and fractions"}
+
+
+def _check_depth_unit(path: Path, duni: Any) -> None:
+    unit = _whole_number(duni)
+    if unit is not None and unit != 1:
+        raise ChartError(
+            f"{path}: the cell gives its depths in {_DEPTH_UNITS.get(unit, f'unit {unit}')} "
+            "(DSPM DUNI), and colregs9 reads depths in metres; give an ENC in metres"
+        )
 
 
 @dataclass(frozen=True)

@@ -51,13 +51,9 @@ def write_chart_geopackage(path: Path, chart: Chart, draught_m: float, ukc_m: fl
     ``navigable_water`` (for the draught and UKC), so that an analyst can check in QGIS the
     water a verdict used."""
 
-    def to_wgs84(xy: np.ndarray) -> np.ndarray:
-        lat_deg, lon_deg = chart.frame.to_geodetic(xy[:, 1], xy[:, 0])
-        return np.column_stack([lon_deg, lat_deg])
-
     def geometries(values: Any) -> np.ndarray:
-        projected = shapely.transform(_multipolygons(values), to_wgs84)
-        return np.asarray(shapely.to_wkb(projected), dtype=object)
+        shapes = chart.frame.shapes_to_wgs84(_multipolygons(values))
+        return np.asarray(shapely.to_wkb(_multipolygons(shapes)), dtype=object)
 
     water = chart.navigable_water(draught_m, ukc_m)
     names = [p.name for p in chart.detail_order]

@@ -77,6 +77,9 @@ def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
             threads_per_worker=1,
             processes=True,
             dashboard_address=None,
+            # The scheduler's HTTP server starts even without a dashboard, on 8787 unless
+            # told otherwise, and warns on stderr when another cluster holds that port.
+            scheduler_kwargs={"dashboard_address": ":0"},
             silence_logs=logging.ERROR,
         )
     # Not made the default client: that is a context variable of the thread that starts it

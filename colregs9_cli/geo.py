@@ -15,11 +15,12 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import shapely
 from numpy.typing import ArrayLike, NDArray
 from pyproj import CRS, Geod, Proj, Transformer
 
 from .errors import ParameterError
-from .units import wrap_deg
+from .units import signed_angle_deg, wrap_deg
 
 # Where the series for the meridian convergence holds to 1.6e-5° (``grid_convergence_deg``).
 _SERIES_REACH_DEG = 10.0
@@ -72,7 +73,15 @@ class LocalFrame:
     def centred_on(
         cls, lat_min: float, lat_max: float, lon_min: float, lon_max: float
     ) -> LocalFrame:
-        return cls((lat_min + lat_max) / 2.0, (lon_min + lon_max) / 2.0)
+        """The frame at the middle of a box; its longitudes are taken the short way round,
+        so that a box split at the antimeridian (-180 … 180) is centred on 180°, not 0°."""
+        if lon_min <= lon_max and lon_max - lon_min <= 180.0:
+            return cls((lat_min + lat_max) / 2.0, (lon_min + lon_max) / 2.0)
+        span = (lon_max - lon_min) % 360.0
+        if span > 180.0:
+            span -= 360.0
+        centre = (lon_min + span / 2.0 + 180.0) % 360.0 - 180.0
+        return cls((lat_min + lat_max) / 2.0, centre)
 
     def to_local(
         self, lat_deg: ArrayLike, lon_deg: ArrayLike
@@ -91,6 +100,37 @@ class LocalFrame:
             np.asarray(east_m, dtype=float), np.asarray(north_m, dtype=float)
         )
         return np.asarray(lat_deg, dtype=float), np.asarray(lon_deg, dtype=float)
+
+    def shapes_to_wgs84(self, shapes: ArrayLike) -> NDArray[np.object_]:
+        """Shapely geometries in this frame as (lon, lat) geometries in WGS84; those that
+        cross the antimeridian are cut there (as RFC 7946 asks), not drawn round the globe."""
+
+        def convert(xy: NDArray[np.float64]) -> NDArray[np.float64]:
+            lat_deg, lon_deg = self.to_geodetic(xy[:, 1], xy[:, 0])
+            # Continuous across 180°: within half a turn of the central meridian.
+            return np.column_stack(
+                [self.lon0_deg + signed_angle_deg(lon_deg - self.lon0_deg), lat_deg]
+            )
+
+        unwrapped = np.asarray(
+            shapely.transform(np.asarray(shapes, dtype=object), convert), dtype=object
+        )
+        bounds = shapely.bounds(unwrapped)
+        crossing = (bounds[..., 0] < -180.0) | (bounds[..., 2] > 180.0)
+        if not crossing.any():
+            return unwrapped
+        across = shapely.make_valid(unwrapped[crossing])
+        parts = shapely.intersection(across, shapely.box(-180.0, -90.0, 180.0, 90.0))
+        for shift, beyond in (
+            (-360.0, shapely.box(180.0, -90.0, 540.0, 90.0)),
+            (360.0, shapely.box(-540.0, -90.0, -180.0, 90.0)),
+        ):
+            moved = shapely.transform(
+                shapely.intersection(across, beyond), lambda xy, s=shift: xy + np.array([s, 0.0])
+            )
+            parts = shapely.union(parts, moved)
+        unwrapped[crossing] = parts
+        return unwrapped
 
     def grid_convergence_deg(self, lat_deg: ArrayLike, lon_deg: ArrayLike) -> NDArray[np.float64]:
         """Meridian convergence γ (degrees) at WGS84 positions: ``grid bearing = true − γ``.

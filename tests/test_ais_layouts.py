@@ -3,6 +3,7 @@ Spire, --columns maps), header-less chunks, and NMEA logs without any time."""
 
 from __future__ import annotations
 
+import csv
 import gzip
 import json
 import subprocess
@@ -20,7 +21,7 @@ from colregs9_cli.ais.load import load_ais
 from colregs9_cli.errors import InputFileError, ParameterError
 from colregs9_cli.stats import run_stats
 
-from fixture_files import AIS_FIXTURES, MARINECADASTRE, NMEA, ROOT
+from fixture_files import AIS_FIXTURES, DMA26, MARINECADASTRE, NMEA, ROOT
 
 MC2015 = AIS_FIXTURES / "marinecadastre2015_sample.csv"
 MC2025 = AIS_FIXTURES / "marinecadastre2025_sample.csv.zst"
@@ -214,6 +215,8 @@ GOOD_TIME = '[time]\nformat = "%Y"\n'
         (GOOD, "[time]: missing"),
         (GOOD + GOOD_TIME + '[units]\nsog_kn = "mph"\n', "[units] sog_kn"),
         (GOOD + GOOD_TIME + '[units]\nname = "m"\n', "[units] name"),
+        (GOOD + GOOD_TIME + '[units]\nsog_kn = ["kn"]\n', "[units] sog_kn"),
+        (GOOD + GOOD_TIME + "[units]\nsog_kn = { x = 1 }\n", "[units] sog_kn"),
         (GOOD + GOOD_TIME + "[sentinels]\nsog_kn = 102.3\n", "[sentinels] sog_kn"),
         (GOOD + GOOD_TIME + 'colour = "red"\n', "colour: unknown key"),
         ('delimiter = "ab"\n' + GOOD + GOOD_TIME, "delimiter"),
@@ -328,3 +331,77 @@ def test_nmea_with_some_times_keeps_rejecting_the_rest(tmp_path: Path) -> None:
     data = load_ais([path])
     assert data.ledger.rejects["unparseable"] >= 1 and data.ledger.balanced
     assert np.isin(["none"], list(data.ledger.time_sources)).sum() == 0
+
+
+def test_dma_file_with_every_field_quoted_reads_as_the_original(tmp_path: Path) -> None:
+
+    quoted = tmp_path / "quoted.csv"
+    with DMA26.open(encoding="utf-8", newline="") as source, quoted.open("w", newline="") as out:
+        csv.writer(out, quoting=csv.QUOTE_ALL).writerows(csv.reader(source))
+    assert quoted.read_text().startswith('"# Timestamp","Type of mobile"')
+    original, again = load_ais([DMA26]), load_ais([quoted])
+    pd.testing.assert_frame_equal(original.positions, again.positions)
+    assert again.ledger.rejects == original.ledger.rejects
+
+
+def test_padded_numbers_beside_null_text_are_numbers(tmp_path: Path) -> None:
+    lines = MARINECADASTRE.read_text(encoding="utf-8").splitlines()[:4]
+    header = lines[0].split(",")
+    draft, length = header.index("Draft"), header.index("Length")
+    rows = [line.split(",") for line in lines[1:]]
+    rows[0][draft], rows[1][draft], rows[2][draft] = " 8.0", "NULL", "7.5 "
+    rows[0][length] = " 99 "
+    padded = tmp_path / "padded.csv"
+    padded.write_text("\n".join([lines[0], *(",".join(r) for r in rows)]) + "\n")
+    data = load_ais([padded])
+    by_mmsi = data.dimension_reports.groupby("mmsi").first()
+    assert sorted(by_mmsi["draught_m"].dropna()) == [7.5, 8.0]
+    assert 99.0 in set(by_mmsi["length_m"])
+    assert data.ledger.rejected_total == 0
+
+
+def test_every_time_unreadable_names_the_first_value(tmp_path: Path) -> None:
+    lines = DMA26.read_text(encoding="utf-8").splitlines()
+    iso = [lines[0], *(line.replace("09/09/2024 ", "2024-09-09T", 1) for line in lines[1:])]
+    path = tmp_path / "iso.csv"
+    path.write_text("\n".join(iso) + "\n")
+    with pytest.raises(InputFileError) as caught:
+        load_ais([path])
+    message = str(caught.value)
+    assert "the first unparseable row" in message
+    assert f"{path}:2: timestamp does not parse" in message and "'2024-09-09T00:00:33'" in message
+
+
+def test_marinecadastre_times_with_a_zone_or_a_fraction_are_utc(tmp_path: Path) -> None:
+    lines = MARINECADASTRE.read_text(encoding="utf-8").splitlines()[:7]
+    rows = [line.split(",") for line in lines[1:]]
+    written = [
+        "2023-01-11T00:00:00Z",
+        "2023-01-11T01:00:00+01:00",
+        "2023-01-10T19:30:00-0430",
+        "2023-01-11 00:00:00.250",
+        "2023-01-11T00:00:00.123456+00",
+        "2023-02-30T00:00:00",  # no such day: Arrow alone would read 2 March
+    ]
+    for row, when in zip(rows, written, strict=True):
+        row[1] = when
+    path = tmp_path / "zones.csv"
+    path.write_text("\n".join([lines[0], *(",".join(r) for r in rows)]) + "\n")
+    data = load_ais([path])
+    midnight = pd.Timestamp("2023-01-11T00:00:00", tz="UTC")
+    got = dict(zip(data.positions["mmsi"], data.positions["timestamp"], strict=True))
+    expected_ms = [0, 0, 0, 250, 123]
+    assert [got[int(r[0])] for r in rows[:5]] == [
+        midnight + pd.Timedelta(milliseconds=ms) for ms in expected_ms
+    ]
+    assert int(rows[5][0]) not in got
+    (example,) = data.ledger.examples["unparseable"]
+    assert "'2023-02-30T00:00:00'" in example
+
+
+def test_dma_day_past_the_month_end_is_unparseable(tmp_path: Path) -> None:
+    lines = DMA26.read_text(encoding="utf-8").splitlines()
+    path = tmp_path / "feb30.csv"
+    path.write_text("\n".join([lines[0], lines[1].replace("09/09/2024", "30/02/2024", 1)]) + "\n")
+    with pytest.raises(InputFileError, match="'30/02/2024 00:00:33'"):
+        load_ais([path])

@@ -124,6 +124,37 @@ def test_trailing_unix_time_after_the_checksum() -> None:
     assert ledger.time_sources == {"arrival": 1}
 
 
+def test_a_unix_time_after_a_space_is_the_arrival_time() -> None:
+    batch, ledger = _read([f"{_position()} {NOON + 61}.011"])
+    assert _rows(batch.positions)[0]["timestamp"] == datetime(
+        2013, 11, 12, 12, 1, 1, 11_000, tzinfo=UTC
+    )
+    assert ledger.time_sources == {"arrival": 1}
+
+
+def test_a_byte_order_mark_before_the_first_sentence_is_ignored() -> None:
+    with_bom, _ = _read(["\ufeff" + _at(0, _position(219000001)), _at(1, _position(219000002))])
+    assert [r["mmsi"] for r in _rows(with_bom.positions)] == [219000001, 219000002]
+
+
+def test_ais_sentences_written_with_a_dollar_are_read() -> None:
+    dollar = "$" + _position(219000002)[1:]
+    batch, ledger = _read([_at(0, _position(219000001)), _at(1, dollar)])
+    assert [r["mmsi"] for r in _rows(batch.positions)] == [219000001, 219000002]
+    assert ledger.rejected_total == 0
+
+
+def test_a_tag_block_with_a_bad_checksum_gives_no_time_and_says_why() -> None:
+    body = f"s:r1,c:{NOON}"
+    bad = f"\\{body}*{int(_checksum(body), 16) ^ 1:02X}\\"
+    batch, ledger = _read([bad + _position()])
+    assert batch.positions.num_rows == 0
+    (example,) = ledger.examples[RejectReason.UNPARSEABLE.value]
+    assert "no tag block c: with a valid checksum" in example
+    good, _ = _read([_tag(body) + _position()])
+    assert good.positions.num_rows == 1
+
+
 def test_a_tag_block_c_beats_a_pending_pghp_time() -> None:
     pghp = _pghp(datetime(2013, 11, 12, 13, 0, 0, tzinfo=UTC))
     batch, _ = _read([pghp, _tag(f"c:{NOON}") + _position()])

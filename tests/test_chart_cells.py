@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -101,3 +102,32 @@ def test_replay_records_the_cells_in_run_json(tmp_path: Path, gap: Path) -> None
     assert files["US5CA72M.000"]["applied"] and not files["US5CA72M.002"]["applied"]
     for item in files.values():
         assert item["sha256"] == hashlib.sha256(Path(item["path"]).read_bytes()).hexdigest()
+
+
+@pytest.mark.parametrize(
+    ("broken", "applied"), [("001", "none: .001 could not"), ("002", "up to .001: .002 could not")]
+)
+def test_an_update_gdal_could_not_apply_is_an_error(
+    tmp_path: Path, broken: str, applied: str
+) -> None:
+    # GDAL skips a corrupt update and every later one without a word.
+    for suffix in ("000", "001", "002"):
+        shutil.copyfile(SANDIEGO_ENC.with_suffix(f".{suffix}"), tmp_path / f"US5CA72M.{suffix}")
+    (tmp_path / f"US5CA72M.{broken}").write_text("not an update\n")
+    with pytest.raises(ChartError, match=f"GDAL applied {applied}"):
+        read_charts([tmp_path / "US5CA72M.000"])
+
+
+def test_a_cell_in_feet_is_refused(tmp_path: Path) -> None:
+
+    annapolis = SANDIEGO_ENC.parents[1] / "charts" / "noaa_enc_US5MD1MC.000"
+    data = bytearray(annapolis.read_bytes())
+    # The DSPM record: RCNM 20 … CSCL 12000, then DUNI 1 (metres) and HUNI 1.
+    found = re.search(rb"\x14....\x02\x10\x0c\xe0\x2e\x00\x00\x01\x01", data, re.S)
+    assert found is not None
+    data[found.start() + 12] = 3  # DUNI: feet
+    feet = tmp_path / "US5MD1MC.000"
+    feet.write_bytes(bytes(data))
+    with pytest.raises(ChartError, match="depths in feet"):
+        read_charts([feet])
+    assert read_charts([annapolis]).cells[0].name

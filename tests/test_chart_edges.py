@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 import shapely
 
-from colregs9_cli.chart import Chart, ChartLayer, load_chart
+from colregs9_cli.chart import Chart, ChartLayer, load_chart, read_charts
+from colregs9_cli.errors import ChartError
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.manoeuvrability import ManoeuvrabilityParams, Restriction, assess_manoeuvrability
 
@@ -142,3 +143,19 @@ def test_a_red_ellipse_inside_the_chart_still_decides_when_others_reach_past_the
     assert (result.restricted & result.covered).any()
     assert (~result.covered).any()
     assert result.restriction is Restriction.RESTRICTED
+
+
+def test_a_depth_area_without_its_depth_is_an_error(tmp_path: Path) -> None:
+    box = [[[10.0, 57.0], [10.1, 57.0], [10.1, 57.1], [10.0, 57.1], [10.0, 57.0]]]
+    features = [
+        {
+            "type": "Feature",
+            "properties": {"OBJL": "DEPARE", "DRVAL1": depth, "DRVAL2": 20.0},
+            "geometry": {"type": "Polygon", "coordinates": box},
+        }
+        for depth in (10.0, None)
+    ]
+    path = tmp_path / "unknown_depth.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    with pytest.raises(ChartError, match="1 of 2 depth areas have no DRVAL1"):
+        read_charts([path])

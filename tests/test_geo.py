@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import shapely
 from pyproj import Geod, Proj
 
 from colregs9_cli.geo import LocalFrame
@@ -90,3 +91,27 @@ def test_convergence_series_agrees_with_proj_everywhere(lat0: float) -> None:
     expected = np.asarray(factors.meridian_convergence, dtype=float)
     assert np.abs(got - expected).max() < 2e-5
     assert np.isnan(frame.grid_convergence_deg(np.nan, 10.0))
+
+
+@pytest.mark.parametrize(
+    ("lon_min", "lon_max", "centre"),
+    [(10.0, 20.0, 15.0), (-180.0, 180.0, -180.0), (170.0, -170.0, -180.0), (-10.0, 10.0, 0.0)],
+)
+def test_a_box_split_at_the_antimeridian_is_centred_on_it(
+    lon_min: float, lon_max: float, centre: float
+) -> None:
+    assert LocalFrame.centred_on(-17.1, -16.9, lon_min, lon_max).lon0_deg == centre
+
+
+def test_shapes_across_the_antimeridian_are_cut_there_in_wgs84() -> None:
+    frame = LocalFrame(-17.0, 180.0)
+    north_m, east_m = frame.to_local(
+        [-17.05, -17.05, -16.95, -16.95], [179.9, -179.9, -179.9, 179.9]
+    )
+    across = shapely.Polygon(np.column_stack([east_m, north_m]))
+    near = shapely.Point(*frame.to_local([-17.0], [179.95])[::-1])
+    cut, point = frame.shapes_to_wgs84([across, near])
+    assert cut.is_valid and cut.geom_type == "MultiPolygon" and len(cut.geoms) == 2
+    assert cut.area == pytest.approx(0.02, rel=1e-3)  # 0.2° by 0.1°, not round the globe
+    assert sorted(round(g.bounds[0], 6) for g in cut.geoms) == [-180.0, 179.9]
+    assert point.x == pytest.approx(179.95)

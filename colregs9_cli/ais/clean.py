@@ -27,7 +27,7 @@ BoolArray = NDArray[np.bool_]
 MMSI_MIN = 201_000_000  # MID 201: the lowest allocated maritime identification digits
 MMSI_MAX = 775_999_999  # MID 775
 MAX_ROT_DEG_PER_MIN = 720.0
-_NUMBER = r"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?\s*$"
+_NUMBER = r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$"
 _NULL_TEXTS = ["", "unknown", "undefined", "unknown value", "not available", "n/a"]
 NULL_TEXTS = frozenset(_NULL_TEXTS)
 # Null in a number column: empty, or one of pyarrow's default null spellings (lower case),
@@ -151,8 +151,10 @@ def to_float(values: pa.Array | pa.ChunkedArray) -> tuple[pa.Array, BoolArray]:
     try:
         return pc.cast(cleaned, pa.float64()), np.zeros(n, dtype=bool)
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
-        numeric = pc.fill_null(pc.match_substring_regex(cleaned, _NUMBER), False)
-        usable = pc.if_else(numeric, cleaned, pa.scalar(None, pa.string()))
+        # Arrow's cast takes no padding, which database and fixed-width exports write.
+        trimmed = pc.utf8_trim_whitespace(cleaned)
+        numeric = pc.fill_null(pc.match_substring_regex(trimmed, _NUMBER), False)
+        usable = pc.if_else(numeric, trimmed, pa.scalar(None, pa.string()))
         bad = pc.and_(pc.fill_null(present, False), pc.invert(numeric))
         return pc.cast(usable, pa.float64()), bad.to_numpy(zero_copy_only=False)
 
@@ -372,3 +374,28 @@ def whole_positive(values: np.ndarray) -> pa.Array:
     with np.errstate(invalid="ignore"):
         usable = (values > 0) & (np.floor(values) == values)
     return pa.array(np.where(usable, values, 0).astype(np.int64), pa.int64(), mask=~usable)
+
+
+def on_the_written_day(
+    stamps: pa.Array | pa.ChunkedArray, text: pa.Array | pa.ChunkedArray, pattern: str
+) -> BoolArray:
+    """Whether each time parsed (not null) falls on the day of the month its text gives.
+
+    Arrow's ``strptime`` carries a day past the month's end over (``30/02`` is 2 March),
+    which would place a corrupt time in another day. Such a day lands on the 1st to 3rd, so
+    only the times read there are checked. ``pattern`` captures the text's ``day`` and
+    ``second``; a leap second (``23:59:60``) is read as the next second, midnight.
+    """
+    parsed = np.asarray(pc.is_valid(stamps).to_numpy(zero_copy_only=False), dtype=bool)
+    early = pc.fill_null(pc.less_equal(pc.day(stamps), 3), False)
+    (suspects,) = np.nonzero(np.asarray(early.to_numpy(zero_copy_only=False), dtype=bool))
+    if not suspects.size:
+        return parsed
+    taken = pa.array(suspects)
+    parts = pc.extract_regex(pc.take(text, taken), pattern)
+    day = pc.cast(pc.struct_field(parts, "day"), pa.int64())
+    leap = pc.fill_null(pc.equal(pc.cast(pc.struct_field(parts, "second"), pa.int64()), 60), False)
+    back = pc.if_else(leap, pa.scalar(1, pa.duration("s")), pa.scalar(0, pa.duration("s")))
+    same = pc.fill_null(pc.equal(pc.day(pc.subtract(pc.take(stamps, taken), back)), day), False)
+    parsed[suspects] = np.asarray(same.to_numpy(zero_copy_only=False), dtype=bool)
+    return parsed

@@ -471,7 +471,7 @@ def _units(path: Path, table: dict[str, Any]) -> tuple[dict[str, float], bool]:
         if target not in UNITS:
             raise _fail(path, key, f"no units to give for it; units apply to {', '.join(UNITS)}")
         allowed = UNITS[target]
-        if unit not in allowed:
+        if not isinstance(unit, str) or unit not in allowed:
             raise _fail(path, key, f"{unit!r}: use one of {', '.join(map(repr, allowed))}")
         units[target] = allowed[unit]
         rot_ais = rot_ais or (target == "rot_deg_per_min" and unit == "ais")

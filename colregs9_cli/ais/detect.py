@@ -85,7 +85,9 @@ class CsvHeader:
 
 
 def normalise_column(name: str) -> str:
-    return name.strip().lstrip("#").strip().strip('"').strip().lower()
+    # DMA writes '# Timestamp'; tools that quote every field write '"# Timestamp"'.
+    unquoted = name.strip().strip('"').strip()
+    return unquoted.lstrip("#").strip().strip('"').strip().lower()
 
 
 def first_line(head: bytes) -> str:

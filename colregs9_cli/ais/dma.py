@@ -34,6 +34,7 @@ from .clean import (
     nav_status_from_text,
     null_outside,
     number_problems,
+    on_the_written_day,
     plausible,
     positive_or_nan,
     whole_positive,
@@ -42,6 +43,7 @@ from .columns import DMA_ABCD, DMA_STATIC_TEXT_COLUMNS, dma_dimension_columns
 from .schema import CANONICAL_SCHEMA
 
 DMA_TIME_FORMAT = "%d/%m/%Y %H:%M:%S"
+_DMA_DAY_AND_SECOND = r"^(?P<day>\d{1,2})/\d{1,2}/\d{4} \d{1,2}:\d{1,2}:(?P<second>\d{1,2})$"
 
 
 def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
@@ -95,7 +97,7 @@ def dma_canonical(batch: pa.RecordBatch, has_abcd: bool) -> tuple[pa.Table, Bool
     """The rows in the canonical schema, and which had a timestamp that does not parse."""
     stamps_text = pc.utf8_trim_whitespace(batch.column("timestamp"))
     stamps = pc.strptime(stamps_text, format=DMA_TIME_FORMAT, unit="s", error_is_null=True)
-    bad_time = np.asarray(pc.is_null(stamps).to_numpy(zero_copy_only=False), dtype=bool)
+    bad_time = ~on_the_written_day(stamps, stamps_text, _DMA_DAY_AND_SECOND)
     mmsi, _ = mmsi_column(batch.column("mmsi"))
     lat, _ = float_column(batch.column("latitude"))
     lon, _ = float_column(batch.column("longitude"))

@@ -443,10 +443,9 @@ def _no_ais_message(inputs: Sequence[InputFile], ledger: RejectsLedger) -> str:
     names = ", ".join(str(i.dataset or i.path) for i in inputs)
     return (
         f"{names}: no valid AIS position report in {ledger.rows_read} AIS rows read, "
-        f"{ledger.rejected_total} rejected "
-        f"({', '.join(f'{k} {v}' for k, v in sorted(ledger.rejects.items())) or 'none'}); "
-        "check that the input holds AIS messages (NMEA !AIVDM/!AIVDO with valid checksums, or "
-        "a known CSV or Parquet layout, see --format) with valid MMSIs"
+        f"{_used_and_rejected(ledger)}{_first_reject(ledger)}; check that the input holds AIS "
+        "messages (NMEA !AIVDM/!AIVDO with valid checksums, or a known CSV or Parquet layout, "
+        "see --format, or --columns for any other CSV) with valid MMSIs and times"
     )
 
 
@@ -454,10 +453,25 @@ def _no_data_message(query: Query, ledger: RejectsLedger) -> str:
     where = f"query '{query.name}'" + (f" ({query.source})" if query.source else "")
     return (
         f"the {where} selects no vessel positions: {ledger.rows_read} rows read, "
-        f"{ledger.rows_outside_query} outside the query, {ledger.rejected_total} rejected "
-        f"({', '.join(f'{k} {v}' for k, v in sorted(ledger.rejects.items())) or 'none'}); "
+        f"{ledger.rows_outside_query} outside the query, {_used_and_rejected(ledger)}; "
         "check the region, time window and vessel filter against the data"
     )
+
+
+def _used_and_rejected(ledger: RejectsLedger) -> str:
+    """What became of the rows that were neither positions used nor outside the query."""
+    rejects = ", ".join(f"{k} {v}" for k, v in sorted(ledger.rejects.items())) or "none"
+    used = f"{ledger.rows_used} static reports used, " if ledger.rows_used else ""
+    return f"{used}{ledger.rejected_total} rejected ({rejects})"
+
+
+def _first_reject(ledger: RejectsLedger) -> str:
+    """The first example of the most common reject: what the user most likely has to fix."""
+    if not ledger.rejects:
+        return ""
+    reason = max(sorted(ledger.rejects), key=lambda r: ledger.rejects[r])
+    examples = ledger.examples.get(reason)
+    return f"; the first {reason} row: {examples[0]}" if examples else ""
 
 
 # -- one file ---------------------------------------------------------------------------------

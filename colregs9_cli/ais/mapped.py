@@ -43,6 +43,7 @@ from .clean import (
     nav_status_code,
     null_outside,
     number_problems,
+    on_the_written_day,
     plausible,
     positive_or_nan,
     whole_positive,
@@ -56,6 +57,11 @@ Batch: TypeAlias = pa.RecordBatch | pa.Table
 CLASS_A_MESSAGES = frozenset({1, 2, 3, 5, 27})
 CLASS_B_MESSAGES = frozenset({18, 19, 24})
 NOT_A_VESSEL_MESSAGES = {4: "Base Station", 11: "Base Station", 9: "SAR Airborne", 21: "AtoN"}
+_ISO_TIME = (
+    r"^(?P<date>\d{4}-\d{2}-\d{2})[T ](?P<time>\d{2}:\d{2}:\d{2})"
+    r"(?:\.(?P<fraction>\d+))?(?P<zone>Z|[+-]\d{2}(?::?\d{2})?)?$"
+)
+_ISO_DAY_AND_SECOND = r"^\d{4}-\d{2}-(?P<day>\d{2})T\d{2}:\d{2}:(?P<second>\d{2})$"
 _MAX_ROT_RAW = 126  # ±127 and -128: turning fast without a rate, or no rate at all
 
 
@@ -215,14 +221,13 @@ def _timestamps(map_: ColumnMap, batch: Batch) -> tuple[pa.Array, BoolArray]:
         with np.errstate(invalid="ignore", over="ignore"):
             milliseconds = np.round(values * scale)
             good = np.isfinite(milliseconds) & (np.abs(milliseconds) < 2**62)
+    elif map_.time_format == ISO_TIME_FORMAT:
+        milliseconds, good = iso_milliseconds(column.cast(pa.string()))
     else:
         text = pc.utf8_trim_whitespace(column.cast(pa.string()))
-        if map_.time_format == ISO_TIME_FORMAT:
-            text = pc.utf8_replace_slice(text, 10, 11, "T")
-        stamps = pc.strptime(text, format=map_.time_format, unit="s", error_is_null=True)
-        seconds = pc.fill_null(stamps.cast(pa.int64()), 0).to_numpy(zero_copy_only=False)
-        good = np.asarray(stamps.is_valid().to_numpy(zero_copy_only=False), dtype=bool)
-        milliseconds = seconds.astype(np.float64) * 1000.0
+        milliseconds, good = _seconds_as_milliseconds(
+            pc.strptime(text, format=map_.time_format, unit="s", error_is_null=True)
+        )
     if map_.has("millisecond"):
         extra, _ = _raw_number(map_, batch, "millisecond")
         extra = np.where(np.isnan(extra), 0.0, extra)
@@ -232,6 +237,48 @@ def _timestamps(map_: ColumnMap, batch: Batch) -> tuple[pa.Array, BoolArray]:
     whole = np.where(good, milliseconds, 0).astype(np.int64)
     stamps_ms = pa.array(whole, pa.int64(), mask=~good).cast(pa.timestamp("ms", tz="UTC"))
     return stamps_ms, ~good
+
+
+def _seconds_as_milliseconds(stamps: pa.Array) -> tuple[FloatArray, BoolArray]:
+    seconds = pc.fill_null(stamps.cast(pa.int64()), 0).to_numpy(zero_copy_only=False)
+    good = np.asarray(stamps.is_valid().to_numpy(zero_copy_only=False), dtype=bool)
+    return seconds.astype(np.float64) * 1000.0, good
+
+
+def iso_milliseconds(text: pa.Array | pa.ChunkedArray) -> tuple[FloatArray, BoolArray]:
+    """ISO 8601 times as milliseconds since the epoch (UTC), and which parse.
+
+    ``2023-01-11T00:00:00``, a space for the ``T``, a fraction of a second (kept to the
+    millisecond) and a zone (``Z``, ``+01:00``, ``-0500``, ``+01``): what MarineCadastre
+    writes, and what pandas and databases write when they save such a column again. A time
+    without a zone is UTC, as the layouts say.
+    """
+    if isinstance(text, pa.ChunkedArray):
+        text = text.combine_chunks()
+    parts = pc.extract_regex(pc.utf8_trim_whitespace(text), _ISO_TIME)
+    whole = pc.binary_join_element_wise(
+        pc.struct_field(parts, "date"), pc.struct_field(parts, "time"), "T"
+    )
+    stamps = pc.strptime(whole, format=ISO_TIME_FORMAT, unit="s", error_is_null=True)
+    milliseconds, good = _seconds_as_milliseconds(stamps)
+    good &= on_the_written_day(stamps, whole, _ISO_DAY_AND_SECOND)
+    fraction = pc.utf8_rpad(
+        pc.utf8_slice_codeunits(pc.struct_field(parts, "fraction"), 0, 3), 3, "0"
+    )
+    fraction_ms = pc.fill_null(pc.cast(fraction, pa.int64()), 0).to_numpy(zero_copy_only=False)
+    zones = pc.dictionary_encode(pc.fill_null(pc.struct_field(parts, "zone"), ""))
+    offsets_min = np.array([_zone_minutes(z) for z in zones.dictionary.to_pylist()], np.float64)
+    zone_min = offsets_min[np.asarray(zones.indices.to_numpy(zero_copy_only=False), np.int64)]
+    return milliseconds + fraction_ms - zone_min * 60_000.0, good
+
+
+def _zone_minutes(zone: str) -> float:
+    """``Z``/empty -> 0, ``+01:00``/``+0100``/``+01`` -> 60, ``-05:30`` -> -330."""
+    if zone in ("", "Z"):
+        return 0.0
+    digits = zone[1:].replace(":", "")
+    minutes = int(digits[:2]) * 60 + (int(digits[2:]) if len(digits) > 2 else 0)
+    return float(-minutes if zone[0] == "-" else minutes)
 
 
 def mapped_static_text(map_: ColumnMap, batch: Batch) -> BoolArray:

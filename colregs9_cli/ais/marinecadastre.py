@@ -11,7 +11,8 @@
   latitude,sog,cog,heading,vessel_name,imo,call_sign,vessel_type,status,length,width,draft,
   cargo,transceiver``, longitude before latitude.
 
-``BaseDateTime`` is ISO 8601 UTC without an offset (``T`` or a space). The numeric
+``BaseDateTime`` is ISO 8601 (``T`` or a space), UTC unless it names a zone
+(``mapped.iso_milliseconds``). The numeric
 ``VesselType`` (ITU-R M.1371) maps to the DMA ship type texts (``ship_type_text``);
 ``Status`` is already the ITU code (0-15, anything else null); the transceiver class A/B
 becomes the mobile type ``Class A``/``Class B``. ``IMO`` is written ``IMO9307839``. Length

@@ -66,6 +66,7 @@ draught beyond ``MAX_DRAUGHT_M``).
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -114,6 +115,7 @@ _MOBILE_TYPE = {t: "Class B" if t in _CLASS_B_TYPES else "Class A" for t in POSI
 _EXAMPLE_CHARS = 160
 _MAX_UNIX_S = 4_102_444_800  # 2100-01-01: larger values are not plausible receive times
 _UNIX_MS_THRESHOLD = 1e11  # above this a c: value is milliseconds
+_TRAILER_SEPARATORS = re.compile(r"[,\s]+")
 
 
 # A message's time: milliseconds since the epoch, and its source.
@@ -264,13 +266,15 @@ class _NmeaReader:
                 if line_tag_ms is not None:
                     self.pending[TimeSource.TAG_BLOCK] = line_tag_ms
                 return
-        if text[0] == "$":
+        is_ais = text[3:6].upper() in ("VDM", "VDO")
+        # Some receivers and converters start AIS sentences with '$'; pyais reads them too.
+        if text[0] == "$" and not is_ais:
             self._other_sentence(text)
             return
-        if text[0] != "!":
+        if text[0] not in "!$":
             self._unparseable(line_no, "not an NMEA sentence", line.strip())
             return
-        if text[3:6].upper() not in ("VDM", "VDO"):
+        if not is_ais:
             self.pending.clear()
             return
         sentence_text, arrival_ms = _split_time_suffix(text)
@@ -353,8 +357,8 @@ class _NmeaReader:
                 self._reject_message(
                     RejectReason.UNPARSEABLE,
                     line_no,
-                    f"no time from the time sources in use ({used}): no $PGHP line before it, "
-                    "no tag block c:, no trailing unix time",
+                    f"no time from the time sources in use ({used}): no valid $PGHP line "
+                    "before it, no tag block c: with a valid checksum, no trailing unix time",
                     raw,
                 )
                 return
@@ -503,11 +507,15 @@ def _finer_observation(
 
 
 def _split_time_suffix(text: str) -> tuple[str, int | None]:
-    """``!AIVDM,...,0*5C,1384257600`` -> (the sentence, 1384257600000 ms)."""
+    """``!AIVDM,...,0*5C,1384257600`` (or ``... 0*5C 1384257600``) -> (the sentence,
+    1384257600000 ms): the last field after the checksum, comma- or space-separated."""
     star = text.rfind("*")
-    if star < 0 or len(text) <= star + 3 or text[star + 3] != ",":
+    if star < 0 or len(text) <= star + 3:
         return text, None
-    return text[: star + 3], _unix_ms(text[star + 4 :].rsplit(",", 1)[-1])
+    rest = text[star + 3 :]
+    if rest[0] != "," and not rest[0].isspace():
+        return text, None
+    return text[: star + 3], _unix_ms(_TRAILER_SEPARATORS.split(rest.strip(", \t"))[-1])
 
 
 def _unix_ms(value: str | None) -> int | None:
@@ -763,7 +771,7 @@ def read_nmea(
     reader = _NmeaReader(source_name, ledger, time_sources, keep_timeless, counts)
     ledger.time_source_order = tuple(s.value for s in reader.time_sources)
     for line_no, line in enumerate(lines, start=1):
-        reader.feed(line_no, line)
+        reader.feed(line_no, line.lstrip("\ufeff") if line_no == 1 else line)
     reader.finish()
     for columns in (reader.statics, reader.positions):  # positions: the type 19 fields
         _count_implausible(columns, source_name, ledger)

@@ -46,14 +46,7 @@ GEOPACKAGE_NAME = "report.gpkg"
 
 
 def _to_wgs84(frame: LocalFrame, geometries: Any) -> np.ndarray:
-    def convert(xy: np.ndarray) -> np.ndarray:
-        lat_deg, lon_deg = frame.to_geodetic(xy[:, 1], xy[:, 0])
-        return np.column_stack([lon_deg, lat_deg])
-
-    return np.asarray(
-        shapely.to_wkb(shapely.transform(np.asarray(geometries, dtype=object), convert)),
-        dtype=object,
-    )
+    return np.asarray(shapely.to_wkb(frame.shapes_to_wgs84(geometries)), dtype=object)
 
 
 # GDAL's time-zone flag for UTC (1 is local time, 100 + n is n quarter-hours east of UTC).
@@ -279,7 +272,8 @@ def write_replay_geopackage(
                 driver="GPKG",
                 geometry_type=_geometry_type(layer),
                 crs="EPSG:4326",
-                promote_to_multi=layer in ("domains", "navigable_water"),
+                # Tracks and domains cut at the antimeridian are multi-part.
+                promote_to_multi=layer in ("tracks", "domains", "navigable_water"),
                 append=written > 0,
             )
             written += 1
@@ -290,7 +284,7 @@ def _geometry_type(layer: str) -> str:
     return {
         "encounters": "Point",
         "cpa": "Point",
-        "tracks": "LineString",
+        "tracks": "MultiLineString",
         "domains": "MultiPolygon",
         "navigable_water": "MultiPolygon",
     }[layer]
