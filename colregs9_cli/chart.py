@@ -63,7 +63,7 @@ from pyproj import CRS, Transformer
 from pyproj.exceptions import CRSError
 
 from .errors import ChartError, ParameterError
-from .geo import LocalFrame
+from .geo import FRAME_REACH_M, LocalFrame
 from .s57_updates import update_files_beside
 
 HAZARD_RADIUS_M = 10.0
@@ -720,6 +720,28 @@ class ChartSource:
         empty when every update sequence is whole."""
         return {cell.name: cell.missing_updates for cell in self.cells if cell.missing_updates}
 
+    def near(self, lat_deg: ArrayLike, lon_deg: ArrayLike, margin_deg: float) -> ChartSource:
+        """The charts whose box, widened by ``margin_deg``, holds one of the positions: those
+        that can judge a ship domain there. The rest would only stretch the run's one frame
+        (centred on the charts) away from the vessels."""
+        lat = np.asarray(lat_deg, dtype=float)
+        lon = np.asarray(lon_deg, dtype=float)
+        kept = []
+        for features in self.features:
+            shapes = [features.geometries]
+            if features.coverage is not None:
+                shapes.append(np.asarray([features.coverage], dtype=object))
+            west, south, east, north = shapely.total_bounds(np.concatenate(shapes))
+            if (
+                (lat >= south - margin_deg)
+                & (lat <= north + margin_deg)
+                & (lon >= west - margin_deg)
+                & (lon <= east + margin_deg)
+            ).any():
+                kept.append(features)
+        paths = tuple(f.path for f in kept)
+        return ChartSource(paths, tuple(kept), tuple(c for c in self.cells if c.path in paths))
+
     def bounds_wgs84(self) -> tuple[float, float, float, float]:
         """(lat_min, lat_max, lon_min, lon_max) of the charts' features and coverage."""
         coverages = np.asarray(
@@ -830,6 +852,23 @@ def _same_dimension(clipped: NDArray[np.object_], original: NDArray[np.object_])
     return clipped
 
 
+def _check_within_reach(source: ChartSource, frame: LocalFrame) -> None:
+    """Charts are projected into one transverse Mercator frame, true to 0.2 % within
+    ``FRAME_REACH_M`` of its centre; beyond, areas and ship domains would be stretched."""
+    lat_min, lat_max, lon_min, lon_max = source.bounds_wgs84()
+    span = (lon_max - lon_min) % 360.0 if lon_max - lon_min < 360.0 else 0.0
+    lats, offsets = np.meshgrid(np.linspace(lat_min, lat_max, 5), np.linspace(0.0, span, 9))
+    if frame.within_reach(lats, lon_min + offsets).all():
+        return
+    names = ", ".join(str(p) for p in source.paths)
+    raise ChartError(
+        f"{names}: the charts span lat {lat_min:.2f} .. {lat_max:.2f}, lon {lon_min:.2f} .. "
+        f"{lon_max:.2f}, beyond {FRAME_REACH_M / 1000:.0f} km of the centre of the one map "
+        "frame they are projected into, which would stretch their areas and the ship domains; "
+        "give the cells of one area at a time (replay leaves out charts away from the AIS)"
+    )
+
+
 def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Chart:
     """Merge charts already read and project them into ``frame`` (default: their extent).
 
@@ -839,6 +878,7 @@ def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Char
     features = _by_detail(source.features)
     if frame is None:
         frame = LocalFrame.centred_on(*source.bounds_wgs84())
+    _check_within_reach(source, frame)
     per_file, coverages = _claimed_by_detail(features, frame)
     geometries = np.concatenate(per_file)
     object_class = np.concatenate([f.object_class for f in features])

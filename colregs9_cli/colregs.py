@@ -292,9 +292,9 @@ def _sectors(
 
     def side(bearing: NDArray[np.float64]) -> NDArray[np.int64]:
         """+1 starboard, −1 port, 0 on the fore-and-aft line."""
-        return np.sign(np.sin(np.radians(bearing))).astype(np.int64) * (
-            (bearing != 0.0) & (bearing != 180.0)
-        )
+        # An unknown bearing (a vessel at rest without a course) is on neither side.
+        sides = np.nan_to_num(np.sign(np.sin(np.radians(bearing))))
+        return sides.astype(np.int64) * ((bearing != 0.0) & (bearing != 180.0))
 
     def off_fore_aft_line(bearing: NDArray[np.float64]) -> NDArray[np.float64]:
         folded = np.mod(bearing, 180.0)

@@ -176,9 +176,12 @@ def dask_drawer(client: Client) -> Drawer:
         progress: ProgressSink,
     ) -> None:
         (shared,) = client.scatter([chart], broadcast=True)
+        # Scattered, not in the task graph: a graph that big (about 0.2 MB an encounter)
+        # makes distributed warn on stderr.
+        outcomes = client.scatter([outcome for outcome, _ in jobs])
         futures = client.map(
             draw_encounter,
-            [outcome for outcome, _ in jobs],
+            outcomes,
             [target for _, target in jobs],
             chart=shared,
             ukc_m=ukc_m,

@@ -110,7 +110,11 @@ def velocity_mps(
     """
     course_rad = np.radians(np.asarray(course_deg, dtype=float))
     speed = np.asarray(speed_mps, dtype=float)
-    return speed * np.cos(course_rad), speed * np.sin(course_rad)
+    at_rest = speed == 0.0  # no velocity whatever her course, known or not (geo.velocity_ecef_mps)
+    return (
+        np.where(at_rest, 0.0, speed * np.cos(course_rad)),
+        np.where(at_rest, 0.0, speed * np.sin(course_rad)),
+    )
 
 
 @dataclass(frozen=True)

@@ -252,11 +252,16 @@ def north_east_units(
 def velocity_ecef_mps(
     lat_deg: ArrayLike, lon_deg: ArrayLike, speed_mps: ArrayLike, course_deg: ArrayLike
 ) -> NDArray[np.float64]:
-    """A speed along a true course as an Earth-centred velocity vector (m/s)."""
+    """A speed along a true course as an Earth-centred velocity vector (m/s). A vessel at
+    rest has no velocity whatever her course: AIS gives a stopped vessel's COG as "not
+    available" (null), which must not make her motion unknown."""
     north, east = north_east_units(lat_deg, lon_deg)
     course = np.radians(np.asarray(course_deg, dtype=float))
     speed = np.asarray(speed_mps, dtype=float)
-    return (speed * np.cos(course))[..., None] * north + (speed * np.sin(course))[..., None] * east
+    at_rest = speed == 0.0
+    north_mps = np.where(at_rest, 0.0, speed * np.cos(course))
+    east_mps = np.where(at_rest, 0.0, speed * np.sin(course))
+    return north_mps[..., None] * north + east_mps[..., None] * east
 
 
 def in_tangent_plane(

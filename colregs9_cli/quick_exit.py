@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import gc
 import os
+import signal
 import sys
 from collections.abc import Callable
 from typing import NoReturn
@@ -53,9 +54,17 @@ def fewer_collections() -> None:
     gc.set_threshold(GC_YOUNG_THRESHOLD, older, oldest)
 
 
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
+
+
 def run_and_exit(main: Callable[[], object]) -> NoReturn:
     """Run ``main`` (a Click or Typer app, which ends with ``SystemExit``), then leave at once
-    with its status. Any other exception propagates, with its traceback, as usual."""
+    with its status. Any other exception propagates, with its traceback, as usual.
+
+    SIGTERM (what ``timeout``, batch schedulers and systemd send) stops a command as Ctrl-C
+    does, so that it removes its staging and scratch directories on the way out."""
+    signal.signal(signal.SIGTERM, _interrupt)
     fewer_collections()
     try:
         main()

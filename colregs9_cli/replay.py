@@ -144,6 +144,11 @@ def run_params(
     )
 
 
+# Charts farther than this from every AIS position are left out of a run (``ChartSource.near``);
+# a ship domain reaches a few kilometres at most.
+CHART_MARGIN_DEG = 0.25
+
+
 def run_frame(query: Query, extent: Extent, chart: ChartSource | None = None) -> LocalFrame:
     """A frame centred on the charts, where the manoeuvrability estimate is made; without
     charts, on the query region, else on the data (``slabs.Extent.frame``).
@@ -450,9 +455,10 @@ def evaluate_pair(
     full = full.iloc[: _contiguous_rows(full["step"].to_numpy())].reset_index(drop=True)
     window = full[full["step"] >= encounter.trigger_step].reset_index(drop=True)
     audit = _audit(window, params.replay, step_s)
-    # G_a and G_d run until the pair is past (the step before it opens), as in the paper.
+    # G_a and G_d run until the pair is past: to the pass, the first step at which it opens,
+    # which is also the last step the audit looks at (its closest approach may lie there).
     opening = np.flatnonzero(window["tcpa_s"].to_numpy()[1:] < 0.0)
-    series = window.iloc[: int(opening[0]) + 1 if len(opening) else len(window)]
+    series = window.iloc[: int(opening[0]) + 2 if len(opening) else len(window)]
 
     dimensions = (
         vessel_dimensions(_static(tracks.vessels, a), params.replay.dimension_overrides),
@@ -870,7 +876,7 @@ def build_manifest(
         "frame": {"lat0_deg": frame.lat0_deg, "lon0_deg": frame.lon0_deg},
         "parameters": jsonable(params),
         "inputs": inputs_manifest(inputs),
-        "charts": charts_manifest(chart_paths),
+        "charts": charts_manifest(chart_paths, chart.detail_order if chart is not None else ()),
         "accept_chart_gaps": accept_chart_gaps,
         "chart_cells": [jsonable(cell) for cell in (chart.cells if chart is not None else ())],
         "ledger": ledger.to_dict(),
@@ -930,7 +936,7 @@ def run_replay(
         params = run_params(query, own_mmsi, overrides)
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
         if write:
-            check_out_dir(target, overwrite)
+            check_out_dir(target, overwrite, inputs=[*ais_paths, *chart_paths])
         slab_s = params.replay.slab_s
         with _scratch_directory(scratch_dir) as scratch:
             spill_dir = Path(scratch) / "spill"
@@ -962,6 +968,10 @@ def run_replay(
                     "two. Widen the query or give more AIS"
                 )
             source = read_charts(chart_paths, accept_chart_gaps) if chart_paths else None
+            if source is not None:
+                points = segmentation.points
+                near = source.near(points["lat_deg"], points["lon_deg"], CHART_MARGIN_DEG)
+                source = near if near.paths else source  # none near: load_run_chart says so
             _check_own(params.own_mmsi, segmentation.vessels)
             frame = run_frame(query, segmentation.extent, source)
             chart: Chart | None = None

@@ -106,8 +106,7 @@ class ReplayParams:
             "course_change_deg",
             "speed_change_frac",
             "reassess_every_s",
-            "slab_s",
-        )
+        )  # slab_s: its range below names --slab-minutes
         for name in positive:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0.0):

@@ -748,7 +748,12 @@ def _cases(work: Path) -> list[Case]:
             "min_sog_kn",
         ),
         Case("replay-alpha-range", ("replay", nmea, "--alpha", "2", *replay_out), 2, "alpha"),
-        Case("replay-slab-zero", ("replay", nmea, "--slab-minutes", "0", *replay_out), 2, "slab_s"),
+        Case(
+            "replay-slab-zero",
+            ("replay", nmea, "--slab-minutes", "0", *replay_out),
+            2,
+            "--slab-minutes 0",
+        ),
         Case(
             "replay-workers-zero", ("replay", nmea, "--workers", "0", *replay_out), 2, "--workers"
         ),

@@ -131,3 +131,13 @@ def test_a_cell_in_feet_is_refused(tmp_path: Path) -> None:
     with pytest.raises(ChartError, match="depths in feet"):
         read_charts([feet])
     assert read_charts([annapolis]).cells[0].name
+
+
+def test_charts_beyond_the_reach_of_one_frame_are_refused() -> None:
+    annapolis = SANDIEGO_ENC.parents[1] / "charts" / "noaa_enc_US5MD1MC.000"
+    source = read_charts([SANDIEGO_ENC, annapolis])
+    with pytest.raises(ChartError, match="beyond 400 km of the centre of the one map frame"):
+        project_charts(source)
+    (near,) = source.near([32.7], [-117.2], margin_deg=0.25).paths
+    assert near == SANDIEGO_ENC
+    assert project_charts(source.near([32.7], [-117.2], margin_deg=0.25)).detail_order

@@ -404,3 +404,12 @@ def test_a_slow_vessels_cog_makes_the_situation_ambiguous() -> None:
     steered = ship(1000, 1000, 270.0, 0.9, heading=270.0)
     assert not evaluate_colregs(own, steered, by_heading, course_judged_above_kn=2.0).ambiguous[0]
     assert evaluate_colregs(own, slow_target, by_heading, course_judged_above_kn=2.0).ambiguous[0]
+
+
+def test_an_unknown_bearing_is_no_situation_and_no_warning() -> None:
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = classify([np.nan, 10.0], [200.0, np.nan], [True, True], ColregsParams())
+    assert list(result.situation) == [Situation.NONE, Situation.NONE]

@@ -31,7 +31,7 @@ from colregs9_cli.cli import app
 from colregs9_cli.errors import InputFileError, NoDataError
 from colregs9_cli.query import Query, Region, TimeWindow, VesselFilter, load_query
 
-from fixture_files import DMA22, DMA26, NMEA, ROOT
+from fixture_files import DMA22, DMA26, MARINECADASTRE, NMEA, ROOT
 
 LIMFJORDEN = ROOT / "queries" / "limfjorden.toml"
 
@@ -352,8 +352,17 @@ def _corrupt_manifest(directory: Path) -> str:
     return "not valid JSON"
 
 
+def _no_partitions(directory: Path) -> str:
+    manifest = json.loads((directory / MANIFEST_NAME).read_text())
+    del manifest["inputs"][0]["partitions"]
+    (directory / MANIFEST_NAME).write_text(json.dumps(manifest))
+    return "input 1 of the manifest is malformed"
+
+
 @pytest.mark.parametrize("command", ["stats", "ingest"])
-@pytest.mark.parametrize("spoil", [_foreign, _wrong_schema, _no_manifest, _corrupt_manifest])
+@pytest.mark.parametrize(
+    "spoil", [_foreign, _wrong_schema, _no_manifest, _corrupt_manifest, _no_partitions]
+)
 def test_a_bad_dataset_gives_one_error_line(tmp_path: Path, spoil, command: str) -> None:  # type: ignore[no-untyped-def]
     """stats reads the dataset, ingest adds to it (a new input and one already in it): each
     checks it whole first, and ingest leaves it as it was."""
@@ -454,3 +463,65 @@ def test_inputs_sharing_a_date_are_told_apart_from_duplicates(tmp_path: Path) ->
     window = read_dataset_window(out, Query("all"), start, end, columns=["mmsi", "sog_kn"])
     assert window.column_names == ["mmsi", "sog_kn"]
     assert window.column("mmsi").to_pylist() == want.positions["mmsi"].tolist()
+
+
+def test_a_file_with_its_columns_in_another_order_reads_the_same(tmp_path: Path) -> None:
+    out = tmp_path / "ais"
+    ingest([DMA26], out)
+    before = dataset_time_range(out)
+    (path,) = out.glob("date=*/part-*.parquet")
+    table = pq.read_table(path)
+    pq.write_table(table.select(list(reversed(table.column_names))), path)
+    assert dataset_time_range(out) == before
+
+
+def test_an_input_already_ingested_under_another_query_is_an_error(tmp_path: Path) -> None:
+    query = tmp_path / "elsewhere.toml"
+    query.write_text(
+        'name = "elsewhere"\n[region]\nlat_min = -10.0\nlat_max = -9.0\n'
+        "lon_min = 0.0\nlon_max = 1.0\n"
+    )
+    out = tmp_path / "ais"
+    first = CliRunner().invoke(
+        app, ["ingest", str(DMA26), "--query", str(query), "--out", str(out)]
+    )
+    assert first.exit_code == 0, first.output
+    again = CliRunner().invoke(app, ["ingest", str(DMA26), "--out", str(out), "--quiet"])
+    assert again.exit_code == 2, again.output
+    (line,) = again.stderr.strip().splitlines()
+    assert "under the query 'elsewhere', not 'all'" in line and line.startswith("Error: ")
+    same = CliRunner().invoke(app, ["ingest", str(DMA26), "--query", str(query), "--out", str(out)])
+    assert same.exit_code == 0 and "already ingested" in same.output
+
+
+def test_ingests_into_one_dataset_at_once_keep_every_input(tmp_path: Path) -> None:
+    import threading
+
+    out = tmp_path / "ais"
+    ingest([DMA26], out)
+    errors: list[BaseException] = []
+
+    def run(path: Path) -> None:
+        try:
+            ingest([path], out)
+        except BaseException as exc:
+            errors.append(exc)
+
+    threads = [threading.Thread(target=run, args=(p,)) for p in (DMA22, MARINECADASTRE, NMEA)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert errors == []
+    listed = {Path(item.path).name for item in Dataset.open(out).inputs}
+    assert listed == {p.name for p in (DMA26, DMA22, MARINECADASTRE, NMEA)}
+    assert not list(out.glob(".ingest-*"))
+
+
+def test_staging_left_by_a_killed_ingest_is_cleared_by_the_next(tmp_path: Path) -> None:
+    out = tmp_path / "ais"
+    ingest([DMA26], out)
+    (out / ".ingest-0123456789ab" / "spill").mkdir(parents=True)
+    ingest([DMA22], out)
+    assert not list(out.glob(".ingest-*"))
+    assert len(Dataset.open(out).inputs) == 2

@@ -115,3 +115,14 @@ def test_shapes_across_the_antimeridian_are_cut_there_in_wgs84() -> None:
     assert cut.area == pytest.approx(0.02, rel=1e-3)  # 0.2° by 0.1°, not round the globe
     assert sorted(round(g.bounds[0], 6) for g in cut.geoms) == [-180.0, 179.9]
     assert point.x == pytest.approx(179.95)
+
+
+def test_a_vessel_at_rest_without_a_course_has_no_velocity() -> None:
+    from colregs9_cli.encounters import velocity_mps
+    from colregs9_cli.geo import velocity_ecef_mps
+
+    at_rest = velocity_ecef_mps([57.0, 57.0], [10.0, 10.0], [0.0, 2.0], [np.nan, np.nan])
+    assert np.array_equal(at_rest[0], np.zeros(3))
+    assert np.isnan(at_rest[1]).all()  # moving with no course: unknown
+    north, east = velocity_mps([0.0, 1.0], [np.nan, 90.0])
+    assert (north[0], east[0]) == (0.0, 0.0) and east[1] == pytest.approx(1.0)

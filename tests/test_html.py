@@ -138,3 +138,13 @@ def test_stats_page_shows_its_table_and_histograms(tmp_path) -> None:
     assert body.count("<tr") == len(run.result.to_frame()) == 3
     assert dom.count('class="figure"') == 1
     assert 'class="missing"' not in dom
+
+
+def test_facts_give_positions_and_distances_to_audit_precision(national_report) -> None:
+    result, out = national_report
+    page = (out / "index.html").read_text(encoding="utf-8")
+    summary = result.encounters[0].summary
+    lat = summary.own_lat_deg_at_trigger
+    assert f"<dt>own_lat_deg_at_trigger</dt><dd>{lat:.6f}</dd>" in page
+    cpa = summary.cpa_m
+    assert f"<dt>cpa_m</dt><dd>{cpa:.1f}</dd>" in page  # tenths: 149.8 is not the 150 threshold

@@ -229,3 +229,36 @@ def test_the_notice_of_what_was_written_is_on_stderr_and_quiet_drops_it(
     quiet = _invoke(*args, "--quiet")
     assert quiet.exit_code == 0, quiet.output
     assert quiet.stderr == "" and quiet.stdout == loud.stdout
+
+
+@pytest.mark.parametrize("command", ["stats", "replay"])
+def test_an_out_that_holds_an_input_is_refused_even_with_overwrite(
+    tmp_path: Path, command: str
+) -> None:
+    from colregs9_cli.ais.dataset import ingest
+
+    given = tmp_path / DMA26.name
+    given.write_bytes(DMA26.read_bytes())
+    dataset = tmp_path / "dataset"
+    ingest([given], dataset)
+    for source, out in ((given, tmp_path), (dataset, dataset)):
+        result = CliRunner().invoke(app, [command, str(source), "--out", str(out), "--overwrite"])
+        assert result.exit_code == 2, result.output
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith(f"Error: {out}: --out is or holds the input {source}")
+    assert given.read_bytes() == DMA26.read_bytes()
+    assert (dataset / "colregs9-dataset.json").exists()
+
+
+def test_a_file_its_writer_made_again_follows_the_umask(tmp_path: Path) -> None:
+    from colregs9_cli.report.atomic import atomic_path
+
+    previous = os.umask(0o002)
+    try:
+        with atomic_path(tmp_path / "made.gpkg", suffix=".gpkg") as tmp:
+            tmp.unlink()  # as GDAL does, then SQLite creates it 0644
+            fd = os.open(tmp, os.O_CREAT | os.O_WRONLY, 0o644)
+            os.close(fd)
+    finally:
+        os.umask(previous)
+    assert _mode(tmp_path / "made.gpkg") == 0o664

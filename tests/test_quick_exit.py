@@ -117,3 +117,31 @@ def test_the_console_script_keeps_error_lines_and_codes(tmp_path: Path) -> None:
     assert done.stderr.startswith("Error: ") and done.stderr.count("\n") == 1
     version = _run("--version", cwd=tmp_path)
     assert version.returncode == 0 and version.stdout.startswith("colregs9 ")
+
+
+def test_sigterm_stops_a_run_as_ctrl_c_does_leaving_nothing_behind(tmp_path: Path) -> None:
+    import signal
+    import time
+
+    from fixture_files import NMEA
+
+    out = tmp_path / "report"
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    command = [sys.executable, "-m", "colregs9_cli", "replay", str(NMEA), "--out", str(out)]
+    run = subprocess.Popen(
+        [*command, "--scratch", str(scratch), "--quiet"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    deadline = time.monotonic() + 120
+    while not any(p.name.endswith(".new") for p in tmp_path.iterdir()):  # writing the report
+        assert run.poll() is None and time.monotonic() < deadline, "the run ended too soon"
+        time.sleep(0.05)
+    run.send_signal(signal.SIGTERM)
+    _, stderr = run.communicate(timeout=60)
+    assert run.returncode == 130
+    assert "Traceback" not in stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["scratch"]
+    assert list(scratch.iterdir()) == []

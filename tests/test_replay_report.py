@@ -443,7 +443,7 @@ def test_figure_axes_read_latitude_and_longitude_with_a_scale_bar(restricted) ->
 
 def test_figure_marks_where_each_track_ends(run) -> None:
     (outcome,) = run.encounters
-    for covers_cpa, note in ((False, "data ends (before CPA)"), (True, "end of track")):
+    for covers_cpa, note in ((False, "series ends before the pass"), (True, "end of track")):
         shown = dataclasses.replace(
             outcome, summary=dataclasses.replace(outcome.summary, data_covers_cpa=covers_cpa)
         )

@@ -136,3 +136,26 @@ def test_report_geopackage_domains_are_typed_and_every_layer_is_styled(sandiego)
         _, _, _, values = pyogrio.raw.read(path, layer=name, columns=[attribute])
         categories = {c.get("value") for c in renderer.iter("category")}
         assert set(map(str, values[0])) <= categories, name
+
+
+def test_a_chart_far_from_the_ais_is_left_out_and_changes_nothing(
+    sandiego, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    from colregs9_cli.replay import run_replay
+
+    from fixture_files import ROOT, SANDIEGO_ENC
+
+    annapolis = ROOT / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
+    out = tmp_path_factory.mktemp("sandiego_and_annapolis")
+    both = run_replay(
+        [SANDIEGO_AIS], chart_paths=[SANDIEGO_ENC, annapolis], out_dir=out, plots=False
+    )
+    charts = json.loads((out / "run.json").read_text())["charts"]
+    assert [(c["path"], c["used"]) for c in charts] == [
+        (str(SANDIEGO_ENC), True),
+        (str(annapolis), False),
+    ]
+    assert both.frame == sandiego.frame  # centred on the San Diego cell, not over Kansas
+    pd.testing.assert_frame_equal(
+        _table(both, "encounters.csv"), _table(sandiego, "encounters.csv")
+    )

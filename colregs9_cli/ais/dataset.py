@@ -35,11 +35,14 @@ skipped.
 from __future__ import annotations
 
 import dataclasses
+import fcntl
 import os
 import secrets
 import shutil
+import sys
 from collections import defaultdict
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
@@ -104,6 +107,8 @@ SORT_ORDER = ("hour of timestamp", "floor(lat_deg)", "floor(lon_deg)", "mmsi", "
 _HOUR_MS = 3_600_000
 _UNDATED_HOUR = -1
 # Spill files: fast to write and read back, and lz4 halves the staging's disk use.
+# Held by the ingest writing the dataset (hidden, so no Parquet engine reads it).
+LOCK_NAME = ".colregs9-ingest.lock"
 _SPILL_OPTIONS = pa.ipc.IpcWriteOptions(compression="lz4")
 
 
@@ -169,19 +174,56 @@ def ingest_with_query(
     if not paths:
         raise InputFileError("no AIS input files given; name at least one file")
     out_dir = Path(out_dir)
+    _dataset_inputs(out_dir)  # refuse a file or a foreign directory before creating anything
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _output_error(out_dir, exc) from None
+    with _ingest_lock(out_dir, quiet):
+        return _ingest_locked(paths, out_dir, query, fmt, quiet, row_group_rows, refuse_empty)
+
+
+@contextmanager
+def _ingest_lock(out_dir: Path, quiet: bool) -> Iterator[None]:
+    """One ingest at a time into a dataset: each rewrites the manifest from the one it read,
+    so two at once would lose an input. A second ingest waits for the first."""
+    try:
+        handle = (out_dir / LOCK_NAME).open("a")
+    except OSError as exc:
+        raise _output_error(out_dir, exc) from None
+    with handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            if not quiet:
+                print(f"Waiting for another colregs9 ingest into {out_dir} ...", file=sys.stderr)
+            fcntl.flock(handle, fcntl.LOCK_EX)
+        # Staging left by an ingest that was killed: no other ingest can be running now.
+        for stale in out_dir.glob(".ingest-*"):
+            shutil.rmtree(stale, ignore_errors=True)
+        yield
+
+
+def _ingest_locked(
+    paths: Sequence[Path],
+    out_dir: Path,
+    query: Query,
+    fmt: str | None,
+    quiet: bool,
+    row_group_rows: int,
+    refuse_empty: bool,
+) -> IngestResult:
     entries = [item.entry for item in _dataset_inputs(out_dir)]
     ingest_params(query)
     sources = [inspect_source(Path(p)) for p in paths]
     known = {entry["sha256"]: entry for entry in entries}
     hashes = [sha256_file(source.path) for source in sources]
+    for source, sha256 in zip(sources, hashes, strict=True):
+        if sha256 in known:
+            _check_same_query(source.path, known[sha256], query)
     new = {h: s for s, h in zip(sources, hashes, strict=True) if h not in known}
     if is_dataset(out_dir):  # as stats and replay check it: no file it does not list
         Dataset.open(out_dir, leftovers=[f"{_prefix(h)}-" for h in new])
-    if new:
-        try:
-            out_dir.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise _output_error(out_dir, exc) from None
     results = []
     total = float(sum(s.size_bytes for s in new.values()))
     with progress_bar("Reading AIS", total, progress_enabled(quiet), in_bytes=True) as bar:
@@ -200,6 +242,19 @@ def ingest_with_query(
     return IngestResult(out_dir, inputs, _summary(out_dir, inputs, entries))
 
 
+def _check_same_query(path: Path, entry: dict[str, Any], query: Query) -> None:
+    """A dataset holds each input once, under the query it was ingested with."""
+    kept = ("region", "time", "vessels")
+    stored = entry.get("query") or {}
+    wanted = query_manifest(query)
+    if any(stored.get(key) != wanted[key] for key in kept):
+        raise ParameterError(
+            f"{path}: already in the dataset (sha256 {entry['sha256'][:16]}…), ingested under "
+            f"the query {stored.get('name')!r}, not {query.name!r}; a dataset holds each input "
+            "once: ingest into another dataset for another query"
+        )
+
+
 def _dataset_inputs(out_dir: Path) -> list[DatasetInput]:
     """The inputs of the dataset ``out_dir``, or none for a new or empty directory."""
     if out_dir.exists() and not out_dir.is_dir():
@@ -208,7 +263,7 @@ def _dataset_inputs(out_dir: Path) -> list[DatasetInput]:
         )
     if (out_dir / MANIFEST_NAME).exists():
         return read_manifest(out_dir)
-    if out_dir.is_dir() and any(out_dir.iterdir()):
+    if out_dir.is_dir() and any(not p.name.startswith(".") for p in out_dir.iterdir()):
         raise OutputError(
             f"{out_dir}: --out holds files but no {MANIFEST_NAME}, so it is not a colregs9 "
             "dataset; give a new or empty directory, or a dataset made by colregs9 ingest"

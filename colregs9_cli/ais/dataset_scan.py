@@ -144,6 +144,11 @@ def _input(entry: dict[str, Any]) -> DatasetInput:
     written = int(entry["rows_written"])
     if written != sum(f.rows for f in files) or written != ledger.rows_used:
         raise ValueError("rows_written does not match its files and its ledger")
+    partitions = {str(day): int(rows) for day, rows in entry["partitions"].items()}
+    if sum(partitions.values()) != written:
+        raise ValueError("partitions do not add up to rows_written")
+    if not isinstance(entry["sha256"], str) or len(entry["sha256"]) != 64:
+        raise ValueError(f"sha256 {entry['sha256']!r} is not a SHA-256 in hex")
     return DatasetInput(
         path=str(entry["path"]),
         sha256=str(entry["sha256"]),
@@ -263,11 +268,12 @@ class Dataset:
     def position_spans_ms(self) -> list[tuple[int, int]]:
         """The first and last timestamps (ms since the epoch) of each row group that holds
         positions, from the statistics alone: where in time the dataset has data."""
-        lat = CANONICAL_SCHEMA.get_field_index("lat_deg")
-        stamp = CANONICAL_SCHEMA.get_field_index("timestamp")
         spans = []
         for fragment in self.arrow.get_fragments():
             metadata = fragment.metadata
+            # By name: another tool may have written the columns in another order.
+            lat = fragment.physical_schema.get_field_index("lat_deg")
+            stamp = fragment.physical_schema.get_field_index("timestamp")
             for index in range(metadata.num_row_groups):
                 group = metadata.row_group(index)
                 lat_stats = group.column(lat).statistics
@@ -322,7 +328,7 @@ def _check_fragment(fragment: ds.ParquetFileFragment, listed: DatasetFile, path:
         raise InputFileError(
             f"{path}: holds {metadata.num_rows} rows, the manifest lists {listed.rows}; {_REMEDY}"
         )
-    lat = CANONICAL_SCHEMA.get_field_index("lat_deg")
+    lat = schema.get_field_index("lat_deg")
     static = 0
     for index in range(metadata.num_row_groups):
         stats = metadata.row_group(index).column(lat).statistics

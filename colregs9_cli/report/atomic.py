@@ -10,7 +10,7 @@ import os
 import secrets
 import shutil
 import stat
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
@@ -67,11 +67,14 @@ def atomic_path(target: Path, suffix: str = ".tmp") -> Iterator[Path]:
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
         tmp = _new_file(target.parent, f".{target.name}.", suffix)
+        mode = stat.S_IMODE(tmp.stat().st_mode)
     except OSError as exc:
         raise _output_error(target, exc) from None
     try:
         yield tmp
         try:
+            # A writer that made the file again (GDAL, through SQLite: 0644) chose its mode.
+            os.chmod(tmp, mode)
             os.replace(tmp, target)
         except OSError as exc:
             raise _output_error(target, exc) from None
@@ -104,11 +107,12 @@ def is_report(directory: Path) -> bool:
     return isinstance(manifest, dict) and manifest.get("tool") == "colregs9"
 
 
-def check_out_dir(out_dir: Path, overwrite: bool = False) -> None:
+def check_out_dir(out_dir: Path, overwrite: bool = False, inputs: Sequence[Path] = ()) -> None:
     """Refuse, before any work, an ``--out`` that cannot take a report: a file, a directory
     under a file, one without write access, the current, a parent or the home directory
-    (the report replaces its directory whole), or a directory holding something other than
-    a colregs9 report (unless ``overwrite``: its content is then replaced)."""
+    (the report replaces its directory whole), one that is or holds one of the run's
+    ``inputs``, or a directory holding something other than a colregs9 report (unless
+    ``overwrite``: its content is then replaced)."""
     if out_dir.exists() and not out_dir.is_dir():
         raise OutputError(f"{out_dir}: --out is a file, not a directory; give a directory")
     existing = out_dir
@@ -130,6 +134,12 @@ def check_out_dir(out_dir: Path, overwrite: bool = False) -> None:
             f"{out_dir}: --out would replace the current, a parent or the home directory; "
             "give a directory of its own for the report"
         )
+    for given in inputs:
+        if resolved == Path(given).resolve() or resolved in Path(given).resolve().parents:
+            raise OutputError(
+                f"{out_dir}: --out is or holds the input {given}, which the report would "
+                "replace; give another directory for the report"
+            )
     if out_dir.is_dir() and any(out_dir.iterdir()) and not is_report(out_dir) and not overwrite:
         raise OutputError(
             f"{out_dir}: --out holds files that are not a colregs9 report; give a new or empty "

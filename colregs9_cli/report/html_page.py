@@ -136,7 +136,8 @@ def cell_text(value: Any) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, float):
-        return f"{value:.0f}" if abs(value) >= 100 else f"{value:.1f}"
+        # Tenths below 1000, so that a CPA of 149.8 m does not read as the 150 m threshold.
+        return f"{value:.0f}" if abs(value) >= 1000 else f"{value:.1f}"
     if isinstance(value, pd.Timestamp):
         return value.strftime("%Y-%m-%d %H:%M:%S")
     return str(getattr(value, "value", value))

@@ -90,7 +90,13 @@ def _facts(outcome: EncounterOutcome) -> list[str]:
     lines = ['<dl class="facts">']
     for name in fields:
         value = getattr(outcome.summary, name)
-        lines.append(f"<dt>{html.escape(name)}</dt><dd>{html.escape(cell_text(value))}</dd>")
+        # Positions to 1e-6° (0.1 m), as in encounters.csv's audit trail, not to table width.
+        position = "lat_deg" in name or "lon_deg" in name
+        if position and isinstance(value, float | np.floating) and not np.isnan(value):
+            text = f"{value:.6f}"
+        else:
+            text = cell_text(value)
+        lines.append(f"<dt>{html.escape(name)}</dt><dd>{html.escape(text)}</dd>")
     lines.append("</dl>")
     return lines
 

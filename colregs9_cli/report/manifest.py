@@ -59,10 +59,13 @@ def run_header(command: str) -> dict[str, Any]:
     }
 
 
-def charts_manifest(paths: Sequence[Path]) -> list[dict[str, Any]]:
+def charts_manifest(
+    paths: Sequence[Path], used: Sequence[Path] | None = None
+) -> list[dict[str, Any]]:
     """Each chart given, with every file that went into it or lies beside it and its sha256:
     an S-57 base cell ``X.000`` with the update files ``X.001``, ``X.002`` …, each marked
-    ``applied`` or not (GDAL applies none after a gap), and the names of those missing."""
+    ``applied`` or not (GDAL applies none after a gap), and the names of those missing.
+    ``used``: the charts the run used (the others lie away from the AIS); default all."""
     charts = []
     for path in paths:
         updates, missing = update_files_beside(path) if path.suffix == ".000" else ([], [])
@@ -76,7 +79,14 @@ def charts_manifest(paths: Sequence[Path]) -> list[dict[str, Any]]:
             }
             for update in updates
         ]
-        charts.append({"path": str(path), "files": files, "missing_updates": missing})
+        charts.append(
+            {
+                "path": str(path),
+                "used": used is None or Path(path) in {Path(u) for u in used},
+                "files": files,
+                "missing_updates": missing,
+            }
+        )
     return charts
 
 

@@ -169,9 +169,9 @@ def format_summary(result: ReplayResult) -> str:
                 "yes" if s.situation_ambiguous else "",
                 s.give_way_vessels or "none",
                 _cell(s.deciding_rule),
-                _number(s.cpa_m, 0),
+                _number(s.cpa_m, 1),  # 149.8, not the 150 m threshold
                 _number(s.tcpa_s, 0),
-                _number(s.actual_min_separation_m, 0),
+                _number(s.actual_min_separation_m, 1),
                 "" if s.give_way_vessel_acted is None else _cell(s.give_way_vessel_acted),
             ]
         )
@@ -383,8 +383,9 @@ def _vessel_label(role: str, name: str | None, mmsi: int, dims: tuple[Any, ...])
 
 
 def _mark_data_end(ax: Any, track: pd.DataFrame, colour: str, role: str, early: bool) -> None:
-    """An × at a track's last position: where the data stops before the closest approach
-    (``early``), else where the figure's series ends."""
+    """An × at a track's last position: where the series stops before the pass (``early``:
+    the data stop, or the window of TCPA + ``tcpa_act_s`` ends while the pair still closes),
+    else where the figure's series ends."""
     east = track["east_m"].to_numpy(dtype=float)
     north = track["north_m"].to_numpy(dtype=float)
     known = np.isfinite(east) & np.isfinite(north)
@@ -398,7 +399,7 @@ def _mark_data_end(ax: Any, track: pd.DataFrame, colour: str, role: str, early: 
             markersize=10,
             markeredgewidth=2.0,
             zorder=MARKER_ZORDER,
-            label=f"{role} data ends (before CPA)" if early else f"{role} end of track",
+            label=f"{role} series ends before the pass" if early else f"{role} end of track",
             gid=f"{role.replace(' ', '-')}-data-end",
         )
 
