@@ -732,12 +732,10 @@ class ChartSource:
             if features.coverage is not None:
                 shapes.append(np.asarray([features.coverage], dtype=object))
             west, south, east, north = shapely.total_bounds(np.concatenate(shapes))
-            if (
-                (lat >= south - margin_deg)
-                & (lat <= north + margin_deg)
-                & (lon >= west - margin_deg)
-                & (lon <= east + margin_deg)
-            ).any():
+            width = east - west + 2.0 * margin_deg
+            # Eastwards from the widened west edge, round 180° if need be.
+            along = np.mod(lon - (west - margin_deg), 360.0) <= width if width < 360.0 else True
+            if ((lat >= south - margin_deg) & (lat <= north + margin_deg) & along).any():
                 kept.append(features)
         paths = tuple(f.path for f in kept)
         return ChartSource(paths, tuple(kept), tuple(c for c in self.cells if c.path in paths))
@@ -854,18 +852,24 @@ def _same_dimension(clipped: NDArray[np.object_], original: NDArray[np.object_])
 
 def _check_within_reach(source: ChartSource, frame: LocalFrame) -> None:
     """Charts are projected into one transverse Mercator frame, true to 0.2 % within
-    ``FRAME_REACH_M`` of its centre; beyond, areas and ship domains would be stretched."""
-    lat_min, lat_max, lon_min, lon_max = source.bounds_wgs84()
-    span = (lon_max - lon_min) % 360.0 if lon_max - lon_min < 360.0 else 0.0
-    lats, offsets = np.meshgrid(np.linspace(lat_min, lat_max, 5), np.linspace(0.0, span, 9))
-    if frame.within_reach(lats, lon_min + offsets).all():
+    ``FRAME_REACH_M`` of its centre; beyond, areas and ship domains would be stretched.
+    Every vertex is checked, so that charts on both sides of 180° are judged as the frame
+    (centred the short way round) sees them."""
+    shapes = [f.geometries for f in source.features]
+    shapes += [
+        np.asarray([f.coverage], dtype=object) for f in source.features if f.coverage is not None
+    ]
+    lon_lat = shapely.get_coordinates(np.concatenate(shapes))
+    if frame.within_reach(lon_lat[:, 1], lon_lat[:, 0]).all():
         return
+    lat_min, lat_max, lon_min, lon_max = source.bounds_wgs84()
     names = ", ".join(str(p) for p in source.paths)
     raise ChartError(
         f"{names}: the charts span lat {lat_min:.2f} .. {lat_max:.2f}, lon {lon_min:.2f} .. "
         f"{lon_max:.2f}, beyond {FRAME_REACH_M / 1000:.0f} km of the centre of the one map "
         "frame they are projected into, which would stretch their areas and the ship domains; "
-        "give the cells of one area at a time (replay leaves out charts away from the AIS)"
+        "give charts that lie within that of their centre (the cells of one area at a time: "
+        "replay leaves out charts away from the AIS)"
     )
 
 

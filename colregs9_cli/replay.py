@@ -936,7 +936,8 @@ def run_replay(
         params = run_params(query, own_mmsi, overrides)
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
         if write:
-            check_out_dir(target, overwrite, inputs=[*ais_paths, *chart_paths])
+            given = [*ais_paths, *chart_paths, *([query_path] if query_path else [])]
+            check_out_dir(target, overwrite, inputs=given)
         slab_s = params.replay.slab_s
         with _scratch_directory(scratch_dir) as scratch:
             spill_dir = Path(scratch) / "spill"

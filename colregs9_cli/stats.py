@@ -69,7 +69,7 @@ def run_stats(
         from .report.atomic import check_out_dir
 
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
-        check_out_dir(target, overwrite, inputs=paths)
+        check_out_dir(target, overwrite, inputs=[*paths, *([query_path] if query_path else [])])
         from .ais.load import count_ais
         from .dimensions import GroupBy, Per, dimension_stats
         from .report.stats_report import build_manifest, format_text, write_stats_reports

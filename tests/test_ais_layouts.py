@@ -405,3 +405,22 @@ def test_dma_day_past_the_month_end_is_unparseable(tmp_path: Path) -> None:
     path.write_text("\n".join([lines[0], lines[1].replace("09/09/2024", "30/02/2024", 1)]) + "\n")
     with pytest.raises(InputFileError, match="'30/02/2024 00:00:33'"):
         load_ais([path])
+
+
+def test_dma_times_with_any_space_before_the_clock_on_the_first(tmp_path: Path) -> None:
+    lines = DMA26.read_text(encoding="utf-8").splitlines()
+    rows = [line.replace("09/09/2024 ", "01/09/2024  ", 1) for line in lines[1:]]
+    path = tmp_path / "first.csv"
+    path.write_text("\n".join([lines[0], *rows]) + "\n")
+    assert load_ais([path]).ledger.rejects == load_ais([DMA26]).ledger.rejects
+
+
+def test_an_iso_zone_no_place_keeps_is_unparseable(tmp_path: Path) -> None:
+    lines = MARINECADASTRE.read_text(encoding="utf-8").splitlines()[:3]
+    rows = [line.split(",") for line in lines[1:]]
+    rows[0][1], rows[1][1] = "2023-01-11T00:00:00+99:99", "2023-01-11T05:30:00+05:30"
+    path = tmp_path / "zones.csv"
+    path.write_text("\n".join([lines[0], *(",".join(r) for r in rows)]) + "\n")
+    data = load_ais([path])
+    assert list(data.positions["timestamp"]) == [pd.Timestamp("2023-01-11", tz="UTC")]
+    assert "'2023-01-11T00:00:00+99:99'" in data.ledger.examples["unparseable"][0]

@@ -667,6 +667,12 @@ def _cases(work: Path) -> list[Case]:
             "--ukc",
         ),
         Case(
+            "stats-ais-a-fifo",
+            ("stats", fifo, "--out", "out/stats", "--quiet"),
+            2,
+            f"{fifo}: a pipe or a device, not a file",
+        ),
+        Case(
             "chart-out-a-fifo",
             ("chart", str(MODELLED_CHART), "--draught", "2", "--out", f"{fifo}.png"),
             2,

@@ -159,3 +159,31 @@ def test_a_depth_area_without_its_depth_is_an_error(tmp_path: Path) -> None:
     path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
     with pytest.raises(ChartError, match="1 of 2 depth areas have no DRVAL1"):
         read_charts([path])
+
+
+def _box_chart(path: Path, west: float, east: float) -> Path:
+    ring = [[west, -17.05], [east, -17.05], [east, -16.95], [west, -16.95], [west, -17.05]]
+    feature = {
+        "type": "Feature",
+        "properties": {"OBJL": "DEPARE", "DRVAL1": 10.0, "DRVAL2": 20.0},
+        "geometry": {"type": "Polygon", "coordinates": [ring]},
+    }
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": [feature]}))
+    return path
+
+
+def test_cells_on_both_sides_of_180_are_one_area(tmp_path: Path) -> None:
+    from colregs9_cli.chart import project_charts
+
+    east = _box_chart(tmp_path / "east.geojson", 179.8, 180.0)
+    west = _box_chart(tmp_path / "west.geojson", -180.0, -179.8)
+    source = read_charts([east, west])
+    chart = project_charts(source)
+    assert chart.frame.lon0_deg in (180.0, -180.0)
+    # AIS just east of 180° keeps the cell that starts across it, a kilometre away.
+    assert source.near([-17.0], [179.99], margin_deg=0.25).paths == (east, west)
+    assert source.near([-17.0], [-179.99], margin_deg=0.25).paths == (east, west)
+    assert source.near([-17.0], [170.0], margin_deg=0.25).paths == ()
+    far = _box_chart(tmp_path / "far.geojson", 0.0, 0.2)
+    with pytest.raises(ChartError, match="beyond 400 km"):
+        project_charts(read_charts([east, west, far]))

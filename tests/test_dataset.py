@@ -525,3 +525,23 @@ def test_staging_left_by_a_killed_ingest_is_cleared_by_the_next(tmp_path: Path) 
     ingest([DMA22], out)
     assert not list(out.glob(".ingest-*"))
     assert len(Dataset.open(out).inputs) == 2
+
+
+def test_a_failed_first_ingest_leaves_no_directory(tmp_path: Path) -> None:
+    out = tmp_path / "new" / "ais"
+    result = CliRunner().invoke(app, ["ingest", str(tmp_path / "nosuch.csv"), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert not out.exists()
+    gps_only = tmp_path / "gps.nmea"
+    gps_only.write_text("$GPRMC,120000,A,5700.0,N,00955.0,E,0.0,0.0,121113,,*00\n")
+    result = CliRunner().invoke(app, ["ingest", str(gps_only), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert not out.exists()
+
+
+def test_a_directory_of_dot_files_is_not_a_dataset(tmp_path: Path) -> None:
+    out = tmp_path / "repo"
+    (out / ".git").mkdir(parents=True)
+    result = CliRunner().invoke(app, ["ingest", str(DMA26), "--out", str(out), "--quiet"])
+    assert result.exit_code == 2, result.output
+    assert "holds files but no colregs9-dataset.json" in result.stderr

@@ -262,3 +262,14 @@ def test_a_file_its_writer_made_again_follows_the_umask(tmp_path: Path) -> None:
     finally:
         os.umask(previous)
     assert _mode(tmp_path / "made.gpkg") == 0o664
+
+
+def test_an_out_that_holds_the_query_is_refused(tmp_path: Path) -> None:
+    query = tmp_path / "q.toml"
+    query.write_text('name = "q"\n')
+    result = CliRunner().invoke(
+        app, ["stats", str(DMA26), "--query", str(query), "--out", str(tmp_path), "--overwrite"]
+    )
+    assert result.exit_code == 2, result.output
+    assert f"--out is or holds the input {query}" in result.stderr
+    assert query.exists()

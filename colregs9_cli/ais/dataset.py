@@ -174,13 +174,22 @@ def ingest_with_query(
     if not paths:
         raise InputFileError("no AIS input files given; name at least one file")
     out_dir = Path(out_dir)
-    _dataset_inputs(out_dir)  # refuse a file or a foreign directory before creating anything
+    # Refuse a bad --out, query or input before creating anything.
+    _dataset_inputs(out_dir)
+    ingest_params(query)
+    sources = [inspect_source(Path(p)) for p in paths]
+    created = not out_dir.exists()
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise _output_error(out_dir, exc) from None
-    with _ingest_lock(out_dir, quiet):
-        return _ingest_locked(paths, out_dir, query, fmt, quiet, row_group_rows, refuse_empty)
+    try:
+        with _ingest_lock(out_dir, quiet):
+            return _ingest_locked(sources, out_dir, query, fmt, quiet, row_group_rows, refuse_empty)
+    except BaseException:
+        if created and not (out_dir / MANIFEST_NAME).exists():
+            shutil.rmtree(out_dir, ignore_errors=True)  # nothing ingested: leave no directory
+        raise
 
 
 @contextmanager
@@ -193,11 +202,19 @@ def _ingest_lock(out_dir: Path, quiet: bool) -> Iterator[None]:
         raise _output_error(out_dir, exc) from None
     with handle:
         try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            if not quiet:
-                print(f"Waiting for another colregs9 ingest into {out_dir} ...", file=sys.stderr)
-            fcntl.flock(handle, fcntl.LOCK_EX)
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                if not quiet:
+                    print(
+                        f"Waiting for another colregs9 ingest into {out_dir} ...", file=sys.stderr
+                    )
+                fcntl.flock(handle, fcntl.LOCK_EX)
+        except OSError as exc:
+            raise OutputError(
+                f"{out_dir}: cannot lock the dataset for the ingest ({exc.strerror or exc}); "
+                "give a dataset on a file system that supports locks"
+            ) from None
         # Staging left by an ingest that was killed: no other ingest can be running now.
         for stale in out_dir.glob(".ingest-*"):
             shutil.rmtree(stale, ignore_errors=True)
@@ -205,7 +222,7 @@ def _ingest_lock(out_dir: Path, quiet: bool) -> Iterator[None]:
 
 
 def _ingest_locked(
-    paths: Sequence[Path],
+    sources: Sequence[Source],
     out_dir: Path,
     query: Query,
     fmt: str | None,
@@ -214,8 +231,6 @@ def _ingest_locked(
     refuse_empty: bool,
 ) -> IngestResult:
     entries = [item.entry for item in _dataset_inputs(out_dir)]
-    ingest_params(query)
-    sources = [inspect_source(Path(p)) for p in paths]
     known = {entry["sha256"]: entry for entry in entries}
     hashes = [sha256_file(source.path) for source in sources]
     for source, sha256 in zip(sources, hashes, strict=True):
@@ -263,7 +278,8 @@ def _dataset_inputs(out_dir: Path) -> list[DatasetInput]:
         )
     if (out_dir / MANIFEST_NAME).exists():
         return read_manifest(out_dir)
-    if out_dir.is_dir() and any(not p.name.startswith(".") for p in out_dir.iterdir()):
+    ours = (LOCK_NAME, ".ingest-")  # the lock, and staging a killed ingest left
+    if out_dir.is_dir() and any(not p.name.startswith(ours) for p in out_dir.iterdir()):
         raise OutputError(
             f"{out_dir}: --out holds files but no {MANIFEST_NAME}, so it is not a colregs9 "
             "dataset; give a new or empty directory, or a dataset made by colregs9 ingest"

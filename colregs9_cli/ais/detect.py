@@ -101,8 +101,14 @@ def first_line(head: bytes) -> str:
 
 def detect_layout(source: Source, head: bytes) -> str:
     """The layout of ``source`` from the first bytes of its (decompressed) data."""
-    if source.compression == "none" and head.startswith(PARQUET_MAGIC):
-        return "parquet"
+    if head.startswith(PARQUET_MAGIC):
+        if source.compression == "none":
+            return "parquet"
+        # Parquet is read by seeking to its footer, which a compressed stream cannot do.
+        raise InputFileError(
+            f"{source.name}: a Parquet file compressed with {source.compression}; decompress "
+            "it (Parquet already compresses its columns)"
+        )
     if head[_TAR_MAGIC_AT : _TAR_MAGIC_AT + len(_TAR_MAGIC)] == _TAR_MAGIC:
         raise InputFileError(
             f"{source.name}: a tar archive; extract it (tar xf {source.path.name}) and give "

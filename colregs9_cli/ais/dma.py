@@ -43,7 +43,7 @@ from .columns import DMA_ABCD, DMA_STATIC_TEXT_COLUMNS, dma_dimension_columns
 from .schema import CANONICAL_SCHEMA
 
 DMA_TIME_FORMAT = "%d/%m/%Y %H:%M:%S"
-_DMA_DAY_AND_SECOND = r"^(?P<day>\d{1,2})/\d{1,2}/\d{4} \d{1,2}:\d{1,2}:(?P<second>\d{1,2})$"
+_DMA_DAY_AND_SECOND = r"^(?P<day>\d{1,2})/\d{1,2}/\d{4}\s+\d{1,2}:\d{1,2}:(?P<second>\d{1,2})$"
 
 
 def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:

@@ -19,6 +19,7 @@ by block as DMA's (see load.py): ``mapped_fields`` converts the columns every ro
 
 from __future__ import annotations
 
+import math
 from typing import TypeAlias
 
 import numpy as np
@@ -269,16 +270,20 @@ def iso_milliseconds(text: pa.Array | pa.ChunkedArray) -> tuple[FloatArray, Bool
     zones = pc.dictionary_encode(pc.fill_null(pc.struct_field(parts, "zone"), ""))
     offsets_min = np.array([_zone_minutes(z) for z in zones.dictionary.to_pylist()], np.float64)
     zone_min = offsets_min[np.asarray(zones.indices.to_numpy(zero_copy_only=False), np.int64)]
-    return milliseconds + fraction_ms - zone_min * 60_000.0, good
+    return milliseconds + fraction_ms - zone_min * 60_000.0, good & np.isfinite(zone_min)
 
 
 def _zone_minutes(zone: str) -> float:
-    """``Z``/empty -> 0, ``+01:00``/``+0100``/``+01`` -> 60, ``-05:30`` -> -330."""
+    """``Z``/empty -> 0, ``+01:00``/``+0100``/``+01`` -> 60, ``-05:30`` -> -330; NaN for a
+    zone no place keeps (beyond ±14 h, or 60 minutes or more)."""
     if zone in ("", "Z"):
         return 0.0
     digits = zone[1:].replace(":", "")
-    minutes = int(digits[:2]) * 60 + (int(digits[2:]) if len(digits) > 2 else 0)
-    return float(-minutes if zone[0] == "-" else minutes)
+    hours, minutes = int(digits[:2]), int(digits[2:]) if len(digits) > 2 else 0
+    if hours > 14 or minutes >= 60:
+        return math.nan
+    offset = hours * 60 + minutes
+    return float(-offset if zone[0] == "-" else offset)
 
 
 def mapped_static_text(map_: ColumnMap, batch: Batch) -> BoolArray:

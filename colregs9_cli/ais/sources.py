@@ -73,8 +73,14 @@ def inspect_source(path: Path) -> Source:
     path = Path(path)
     if not path.exists():
         raise InputFileError(f"{path}: no such file; check the path")
-    if not path.is_file():
+    if path.is_dir():
         raise InputFileError(f"{path}: not a file; give AIS files, not a directory")
+    if not path.is_file():
+        # Each input is read twice (its sha256, then its rows), which a stream cannot give.
+        raise InputFileError(
+            f"{path}: a pipe or a device, not a file; give the AIS file itself (compressed or "
+            "not: colregs9 decompresses it)"
+        )
     size = path.stat().st_size
     if size == 0:
         raise InputFileError(f"{path}: the file is empty; give a file with AIS data")
