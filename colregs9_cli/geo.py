@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from pyproj import CRS, Geod, Proj, Transformer
 
 from .errors import ParameterError
-from .units import signed_angle_deg, wrap_deg
+from .units import wrap_deg
 
 # Where the series for the meridian convergence holds to 1.6e-5° (``grid_convergence_deg``).
 _SERIES_REACH_DEG = 10.0
@@ -108,9 +108,9 @@ class LocalFrame:
         def convert(xy: NDArray[np.float64]) -> NDArray[np.float64]:
             lat_deg, lon_deg = self.to_geodetic(xy[:, 1], xy[:, 0])
             # Continuous across 180°: within half a turn of the central meridian.
-            return np.column_stack(
-                [self.lon0_deg + signed_angle_deg(lon_deg - self.lon0_deg), lat_deg]
-            )
+            # A whole number of turns added: exact where nothing is added.
+            turns = np.round((self.lon0_deg - lon_deg) / 360.0)
+            return np.column_stack([lon_deg + 360.0 * turns, lat_deg])
 
         unwrapped = np.asarray(
             shapely.transform(np.asarray(shapes, dtype=object), convert), dtype=object

@@ -54,7 +54,13 @@ def fewer_collections() -> None:
     gc.set_threshold(GC_YOUNG_THRESHOLD, older, oldest)
 
 
+# The status of a command stopped by SIGTERM: 128 + 15, as a shell reports it.
+TERMINATED_STATUS = 143
+_terminated: list[int] = []
+
+
 def _interrupt(signum: int, frame: object) -> None:
+    _terminated.append(signum)
     raise KeyboardInterrupt
 
 
@@ -63,7 +69,8 @@ def run_and_exit(main: Callable[[], object]) -> NoReturn:
     with its status. Any other exception propagates, with its traceback, as usual.
 
     SIGTERM (what ``timeout``, batch schedulers and systemd send) stops a command as Ctrl-C
-    does, so that it removes its staging and scratch directories on the way out."""
+    does, so that it removes its staging and scratch directories on the way out, and it
+    leaves with status 143."""
     signal.signal(signal.SIGTERM, _interrupt)
     fewer_collections()
     try:
@@ -71,4 +78,6 @@ def run_and_exit(main: Callable[[], object]) -> NoReturn:
         status = 0
     except SystemExit as exit_:
         status = exit_status(exit_)
+    if _terminated:
+        status = TERMINATED_STATUS
     os._exit(flush_streams(status))

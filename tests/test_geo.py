@@ -126,3 +126,11 @@ def test_a_vessel_at_rest_without_a_course_has_no_velocity() -> None:
     assert np.isnan(at_rest[1]).all()  # moving with no course: unknown
     north, east = velocity_mps([0.0, 1.0], [np.nan, 90.0])
     assert (north[0], east[0]) == (0.0, 0.0) and east[1] == pytest.approx(1.0)
+
+
+def test_shapes_away_from_180_convert_exactly() -> None:
+    frame = LocalFrame(32.7, -117.2)
+    north_m, east_m = frame.to_local([32.6, 32.8], [-117.3, -117.1])
+    (line,) = frame.shapes_to_wgs84([shapely.LineString(np.column_stack([east_m, north_m]))])
+    lat_deg, lon_deg = frame.to_geodetic(north_m, east_m)
+    assert np.array_equal(shapely.get_coordinates(line), np.column_stack([lon_deg, lat_deg]))

@@ -16,6 +16,7 @@ Used by ``load.load_ais`` (so a dataset is accepted wherever AIS files are) and 
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from datetime import UTC, date, datetime, timedelta
@@ -147,7 +148,7 @@ def _input(entry: dict[str, Any]) -> DatasetInput:
     partitions = {str(day): int(rows) for day, rows in entry["partitions"].items()}
     if sum(partitions.values()) != written:
         raise ValueError("partitions do not add up to rows_written")
-    if not isinstance(entry["sha256"], str) or len(entry["sha256"]) != 64:
+    if not isinstance(entry["sha256"], str) or not re.fullmatch(r"[0-9a-f]{64}", entry["sha256"]):
         raise ValueError(f"sha256 {entry['sha256']!r} is not a SHA-256 in hex")
     return DatasetInput(
         path=str(entry["path"]),
