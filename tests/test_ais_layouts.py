@@ -424,3 +424,15 @@ def test_an_iso_zone_no_place_keeps_is_unparseable(tmp_path: Path) -> None:
     data = load_ais([path])
     assert list(data.positions["timestamp"]) == [pd.Timestamp("2023-01-11", tz="UTC")]
     assert "'2023-01-11T00:00:00+99:99'" in data.ledger.examples["unparseable"][0]
+
+
+def test_exactearth_day_past_the_month_end_is_unparseable(tmp_path: Path) -> None:
+    lines = (AIS_FIXTURES / "exactearth_sample.csv").read_text(encoding="utf-8").splitlines()
+    path = tmp_path / "feb30.csv"
+    moved = [line.replace("20230111_", "20230230_", 1) for line in lines[1:3]]
+    path.write_text("\n".join([lines[0], *moved, *lines[3:]]) + "\n")
+    data = load_ais([path])
+    # The position is unparseable; the static report beside it needs no time (load.py step 4).
+    assert data.ledger.rejects["unparseable"] == 1
+    assert "'20230230_000000'" in data.ledger.examples["unparseable"][0]
+    assert not (data.positions["timestamp"].dt.month == 3).any()

@@ -13,6 +13,7 @@ from __future__ import annotations
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
+from datetime import datetime
 
 import numpy as np
 import pyarrow as pa
@@ -398,4 +399,34 @@ def on_the_written_day(
     back = pc.if_else(leap, pa.scalar(1, pa.duration("s")), pa.scalar(0, pa.duration("s")))
     same = pc.fill_null(pc.equal(pc.day(pc.subtract(pc.take(stamps, taken), back)), day), False)
     parsed[suspects] = np.asarray(same.to_numpy(zero_copy_only=False), dtype=bool)
+    return parsed
+
+
+def on_a_real_day(
+    stamps: pa.Array | pa.ChunkedArray, text: pa.Array | pa.ChunkedArray, time_format: str
+) -> BoolArray:
+    """``on_the_written_day`` for any strftime ``time_format``: whether each time parsed (not
+    null) was written on a day of the calendar. Only the times read as the 1st to 3rd are
+    checked: printed back in the format, and where the text is not written as the format
+    prints it (no zero padding, say), by Python's ``strptime``, which refuses such a day."""
+    parsed = np.asarray(pc.is_valid(stamps).to_numpy(zero_copy_only=False), dtype=bool)
+    if "%d" not in time_format:
+        return parsed
+    early = pc.fill_null(pc.less_equal(pc.day(stamps), 3), False)
+    (suspects,) = np.nonzero(np.asarray(early.to_numpy(zero_copy_only=False), dtype=bool))
+    if not suspects.size:
+        return parsed
+    taken = pa.array(suspects)
+    written = pc.take(text, taken)
+    try:
+        printed = pc.strftime(pc.take(stamps, taken), format=time_format)
+        same = pc.fill_null(pc.equal(printed, written), False)
+        as_printed = np.asarray(same.to_numpy(zero_copy_only=False), dtype=bool)
+    except (pa.ArrowInvalid, pa.ArrowNotImplementedError):
+        as_printed = np.zeros(suspects.size, dtype=bool)
+    for index in np.flatnonzero(~as_printed):
+        try:
+            datetime.strptime(str(written[index]), time_format)
+        except ValueError:
+            parsed[suspects[index]] = False
     return parsed

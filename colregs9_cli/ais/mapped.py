@@ -44,6 +44,7 @@ from .clean import (
     nav_status_code,
     null_outside,
     number_problems,
+    on_a_real_day,
     on_the_written_day,
     plausible,
     positive_or_nan,
@@ -226,9 +227,9 @@ def _timestamps(map_: ColumnMap, batch: Batch) -> tuple[pa.Array, BoolArray]:
         milliseconds, good = iso_milliseconds(column.cast(pa.string()))
     else:
         text = pc.utf8_trim_whitespace(column.cast(pa.string()))
-        milliseconds, good = _seconds_as_milliseconds(
-            pc.strptime(text, format=map_.time_format, unit="s", error_is_null=True)
-        )
+        stamps = pc.strptime(text, format=map_.time_format, unit="s", error_is_null=True)
+        milliseconds, good = _seconds_as_milliseconds(stamps)
+        good &= on_a_real_day(stamps, text, map_.time_format)
     if map_.has("millisecond"):
         extra, _ = _raw_number(map_, batch, "millisecond")
         extra = np.where(np.isnan(extra), 0.0, extra)
