@@ -436,3 +436,25 @@ def test_exactearth_day_past_the_month_end_is_unparseable(tmp_path: Path) -> Non
     assert data.ledger.rejects["unparseable"] == 1
     assert "'20230230_000000'" in data.ledger.examples["unparseable"][0]
     assert not (data.positions["timestamp"].dt.month == 3).any()
+
+
+def test_ship_type_categories_are_one_spelling_whatever_the_case(tmp_path: Path) -> None:
+    from colregs9_cli.ais.clean import clean_ship_type
+
+    written = pa.array(["Cargo", "CARGO", " cargo ", "towing LONG/wide", "Hovercraft", None, ""])
+    assert clean_ship_type(written).to_pylist() == [
+        "Cargo",
+        "Cargo",
+        "Cargo",
+        "Towing long/wide",
+        "Hovercraft",  # not a category: as written
+        None,
+        None,
+    ]
+    lines = DMA26.read_text(encoding="utf-8").splitlines()
+    shouted = [lines[0], *(line.replace(",Cargo,", ",CARGO,") for line in lines[1:])]
+    path = tmp_path / "shouted.csv"
+    path.write_text("\n".join(shouted) + "\n")
+    assert set(load_ais([path]).positions["ship_type"].dropna()) == set(
+        load_ais([DMA26]).positions["ship_type"].dropna()
+    )

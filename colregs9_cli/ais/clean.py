@@ -104,6 +104,9 @@ SHIP_TYPE_CATEGORIES: dict[int, str] = {
 }
 
 
+_SHIP_TYPE_SPELLINGS = {name.lower(): name for name in SHIP_TYPE_CATEGORIES.values()}
+
+
 def nav_status_code(text: str | None) -> int | None:
     """The ITU code of a navigational status text; DMA's ``Unknown value`` is 15 ("not
     defined", the AIS default), unrecognised or empty text is null."""
@@ -218,6 +221,19 @@ def clean_text(values: pa.Array | pa.ChunkedArray) -> pa.Array:
     text = pc.utf8_trim_whitespace(values.cast(pa.string()))
     missing = pc.is_in(pc.utf8_lower(text), value_set=pa.array(_NULL_TEXTS))
     return pc.if_else(missing, pa.scalar(None, pa.string()), text)
+
+
+def clean_ship_type(values: pa.Array | pa.ChunkedArray) -> pa.Array:
+    """``clean_text``, with each ship type category of ``SHIP_TYPE_CATEGORIES`` in one
+    spelling whatever its case (DMA's ``Cargo``, an export's ``CARGO``): one group in
+    ``stats --by ship_type``, as a query matches them. Other texts stay as written."""
+    text = clean_text(values)
+    encoded = pc.dictionary_encode(text)
+    names = [
+        None if name is None else _SHIP_TYPE_SPELLINGS.get(name.lower(), name)
+        for name in encoded.dictionary.to_pylist()
+    ]
+    return pc.take(pa.array(names, pa.string()), encoded.indices)
 
 
 def valid_mmsi(mmsi: NDArray[np.int64]) -> BoolArray:

@@ -34,6 +34,7 @@ from .clean import (
     FloatArray,
     clean_angle,
     clean_rot,
+    clean_ship_type,
     clean_sog,
     clean_text,
     dimension,
@@ -183,7 +184,7 @@ def _ship_types(map_: ColumnMap, batch: Batch) -> pa.Array:
     text = _text(map_, batch, "ship_type")
     codes, not_number = float_column(text)
     coded = ship_type_text(codes)
-    return pc.if_else(pa.array(not_number), text, coded)
+    return pc.if_else(pa.array(not_number), clean_ship_type(text), coded)
 
 
 def _nav_status(map_: ColumnMap, batch: Batch) -> pa.Array:
