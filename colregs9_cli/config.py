@@ -33,6 +33,10 @@ def read_toml(path: Path) -> dict[str, Any]:
         raise QueryError(f"{path}: TOML syntax error: {exc}; fix the file") from None
     except UnicodeDecodeError as exc:
         raise QueryError(f"{path}: not UTF-8 text ({exc.reason}); save it as UTF-8") from None
+    except ValueError:  # an integer of more digits than Python converts
+        raise QueryError(
+            f"{path}: a number of more than 4300 digits; give numbers of a sensible size"
+        ) from None
 
 
 def _accepts(annotation: Any, value: Any) -> bool:

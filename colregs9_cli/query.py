@@ -26,7 +26,7 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from datetime import UTC, date, datetime, time
+from datetime import UTC, date, datetime, time, timedelta
 from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
@@ -145,6 +145,17 @@ class Region:
                 self.polygon, lon[candidates], lat[candidates]
             )
         return inside
+
+
+_EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
+
+
+def ms_at_or_after(moment: datetime) -> int:
+    """The first millisecond since the epoch (the schema's unit) at or after ``moment``, in
+    integers: a row at ``t`` ms is at or after ``moment`` exactly when ``t`` is at or after it,
+    so a bound of ``00:00:01.0001`` keeps no row of ``00:00:01.000``."""
+    microseconds = (moment - _EPOCH) // timedelta(microseconds=1)
+    return -(-microseconds // 1000)
 
 
 @dataclass(frozen=True)
@@ -394,15 +405,28 @@ def _polygon_from_text(text: Any, where: str) -> Polygon | MultiPolygon:
         geojson = json.loads(text)
     except json.JSONDecodeError as exc:
         raise QueryError(f"{where}: not valid JSON ({exc})") from None
+    except ValueError:  # an integer of more digits than Python converts
+        raise QueryError(
+            f"{where}: a number of more than 4300 digits; give coordinates in degrees"
+        ) from None
     except RecursionError:
         raise QueryError(f"{where}: the GeoJSON is nested too deeply to be a polygon") from None
     return _polygon_from_geojson(geojson, where)
 
 
 def _polygon_from_file(query_path: Path, relative: Any) -> Polygon | MultiPolygon:
-    if not isinstance(relative, str):
+    if not isinstance(relative, str) or "\0" in relative:
         raise QueryError(f"{query_path}: [region] polygon_file = {relative!r}; give a path")
-    polygon_path = (query_path.parent / relative).resolve()
+    try:
+        polygon_path = (query_path.parent / relative).resolve()
+        polygon_path.stat()
+    except FileNotFoundError:
+        pass
+    except OSError as exc:
+        raise InputFileError(
+            f"{query_path}: [region] polygon_file {relative!r}: {exc.strerror}; give a path "
+            "to a GeoJSON file"
+        ) from None
     if polygon_path.is_dir():
         raise InputFileError(
             f"{query_path}: [region] polygon_file {relative!r} is {polygon_path}, a directory, "
@@ -416,6 +440,8 @@ def _polygon_from_file(query_path: Path, relative: Any) -> Polygon | MultiPolygo
         text = polygon_path.read_text(encoding="utf-8")
     except UnicodeDecodeError:
         raise QueryError(f"{polygon_path}: not UTF-8 text; save the GeoJSON as UTF-8") from None
+    except OSError as exc:
+        raise InputFileError(f"{polygon_path}: cannot read it ({exc.strerror})") from None
     return _polygon_from_text(text, f"{polygon_path}")
 
 
@@ -428,6 +454,8 @@ def _first_bad_coordinate(coordinates: Any) -> Any:
                 return bad
         return None
     if isinstance(coordinates, bool) or not isinstance(coordinates, int | float):
+        return coordinates
+    if isinstance(coordinates, int) and abs(coordinates) > 360:  # no degree, and too big a float
         return coordinates
     return None if math.isfinite(coordinates) else coordinates
 

@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 from shapely.geometry import LineString, Point
 
-from .ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
+from .ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M, MMSI_MAX, MMSI_MIN
 from .chart import Chart, load_chart
 from .config import read_toml
 from .errors import QueryError
@@ -184,6 +184,11 @@ def _route(value: list[Any], where: str) -> tuple[tuple[float, float], ...]:
                 f"{where}: route waypoint {index} = {item!r} is not a position; give [lat, lon] "
                 "in degrees, latitude first"
             )
+        if points and points[-1] == (lat_deg, lon_deg):
+            raise QueryError(
+                f"{where}: route waypoint {index} = {item!r} repeats the one before it; a leg "
+                "needs two different waypoints"
+            )
         points.append((lat_deg, lon_deg))
     if len(points) < 2:
         raise QueryError(f"{where}: route has {len(points)} waypoint(s); give at least 2")
@@ -229,8 +234,12 @@ def _vessel(table: Any, index: int, source: Path) -> VesselSpec:
     role_text = values.get("role", VesselRole.TARGET.value)
     if role_text not in {r.value for r in VesselRole}:
         raise QueryError(f"{where}: key 'role' = {role_text!r}; give 'own' or 'target'")
-    if not 100_000_000 <= values["mmsi"] <= 999_999_999:
-        raise QueryError(f"{where}: key 'mmsi' = {values['mmsi']!r} is not a 9-digit MMSI")
+    if not MMSI_MIN <= values["mmsi"] <= MMSI_MAX:
+        # Other MMSIs (base stations, SAR aircraft, AtoN) are no vessel to every reader.
+        raise QueryError(
+            f"{where}: key 'mmsi' = {values['mmsi']!r} is not a ship's MMSI; give 9 digits "
+            f"from {MMSI_MIN} to {MMSI_MAX}"
+        )
     for key, limit_m in DIMENSION_LIMITS_M.items():
         _positive(values[key], where, key)
         if values[key] > limit_m:

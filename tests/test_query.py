@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from colregs9_cli.errors import InputFileError, QueryError
+from colregs9_cli.errors import Colregs9Error, InputFileError, QueryError
 from colregs9_cli.query import Region, everything_query, load_query
 
 from fixture_files import ROOT
@@ -182,3 +182,33 @@ def test_a_polygon_vertex_that_is_not_a_finite_number(tmp_path: Path, value: str
         warnings.simplefilter("error")
         with pytest.raises(QueryError, match="is not a finite number"):
             load_query(write(tmp_path, f"[region]\npolygon = '{polygon}'\n"))
+
+
+def test_time_bounds_finer_than_a_millisecond_keep_exactly_the_rows_inside(tmp_path: Path) -> None:
+    from datetime import UTC, datetime
+
+    from colregs9_cli.query import ms_at_or_after
+
+    assert ms_at_or_after(datetime(2023, 1, 11, 0, 0, 1, 100, tzinfo=UTC)) == 1673395201001
+    assert ms_at_or_after(datetime(2023, 1, 11, 0, 0, 1, tzinfo=UTC)) == 1673395201000
+    assert ms_at_or_after(datetime(1969, 12, 31, 23, 59, 59, 999_500, tzinfo=UTC)) == 0
+
+
+def _outsize_queries() -> list[tuple[str, str]]:
+    polygon = json.dumps({"type": "Polygon", "coordinates": [[[0, 1], [2, 2], [3, 1], [0, 1]]]})
+    big, huge = "9" * 400, "9" * 5000
+    return [
+        (f"[region]\npolygon = '{polygon.replace('[0, 1]', f'[{big}, 1]', 1)}'\n", "polygon"),
+        (f"[region]\npolygon = '{polygon.replace('[0, 1]', f'[{huge}, 1]', 1)}'\n", "4300"),
+        (f"[vessels]\nlength_min_m = {huge}\n", "4300 digits"),
+        ('[region]\npolygon_file = "a\\u0000b"\n', "polygon_file"),
+        (f'[region]\npolygon_file = "{"a" * 5000}"\n', "polygon_file"),
+    ]
+
+
+@pytest.mark.parametrize(("text", "names"), _outsize_queries())
+def test_outsize_query_values_are_one_query_error(tmp_path: Path, text: str, names: str) -> None:
+    path = tmp_path / "q.toml"
+    path.write_text(text)
+    with pytest.raises(Colregs9Error, match=names):
+        load_query(path)

@@ -163,3 +163,25 @@ def test_cli_writes_the_default_path(tmp_path: Path, monkeypatch) -> None:
     assert result.exit_code == 0, result.output
     assert (tmp_path / "reports" / "simulate-unit.csv").is_file()
     assert "36 AIS reports" in result.output
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "says"),
+    [
+        ("    [57.067271, 9.972291],\n", "    [57.075500, 9.966800],\n", "repeats the one before"),
+        ("mmsi = 219999002", "mmsi = 999999002", "is not a ship's MMSI"),
+    ],
+)
+def test_a_scenario_no_reader_could_use_is_one_error(
+    tmp_path: Path, old: str, new: str, says: str
+) -> None:
+    from fixture_files import SCENARIOS
+
+    text = (SCENARIOS / "greenhopper_restricted.toml").read_text(encoding="utf-8")
+    assert old in text
+    scenario = tmp_path / "bad.toml"
+    scenario.write_text(text.replace(old, new, 1))
+    result = CliRunner().invoke(app, ["simulate", str(scenario), "--out", str(tmp_path / "o.csv")])
+    assert result.exit_code == 2, result.output
+    (line,) = result.stderr.strip().splitlines()
+    assert line.startswith("Error: ") and says in line

@@ -27,7 +27,7 @@ import pyarrow as pa
 import pyarrow.dataset as ds
 
 from ..errors import InputFileError
-from ..query import Query
+from ..query import Query, ms_at_or_after
 from .ledger import RejectsLedger
 from .query_rows import rows_in_query
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
@@ -59,8 +59,9 @@ def manifest_schema() -> list[dict[str, str]]:
 
 
 def utc_ms(moment: datetime) -> int:
-    """Milliseconds since the epoch, the schema's unit (rounded as ``load._in_query`` does)."""
-    return round(moment.timestamp() * 1000)
+    """Milliseconds since the epoch, the schema's unit: the first at or after ``moment``
+    (``query.ms_at_or_after``, as ``query_rows`` tests a window)."""
+    return ms_at_or_after(moment)
 
 
 def ms_date(milliseconds: int) -> date:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pyarrow as pa
 
-from ..query import Query
+from ..query import Query, ms_at_or_after
 from .clean import to_numpy_float
 
 
@@ -35,9 +35,9 @@ def rows_in_window_and_filter(table: pa.Table, query: Query) -> np.ndarray:
             to_numpy_float(stamps.cast(pa.float64())) if stamps.null_count else stamps.to_numpy()
         )
         if window.start is not None:
-            keep &= milliseconds >= round(window.start.timestamp() * 1000)
+            keep &= milliseconds >= ms_at_or_after(window.start)
         if window.end is not None:
-            keep &= milliseconds < round(window.end.timestamp() * 1000)
+            keep &= milliseconds < ms_at_or_after(window.end)
     if not query.vessels.selects_all:
         keep &= query.vessels.selects(
             table.column("mmsi").to_numpy(),
