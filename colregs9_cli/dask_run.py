@@ -176,18 +176,19 @@ def dask_drawer(client: Client) -> Drawer:
         progress: ProgressSink,
     ) -> None:
         (shared,) = client.scatter([chart], broadcast=True)
-        # Scattered, not in the task graph: a graph that big (about 0.2 MB an encounter)
-        # makes distributed warn on stderr.
-        outcomes = client.scatter([outcome for outcome, _ in jobs])
-        futures = client.map(
-            draw_encounter,
-            outcomes,
-            [target for _, target in jobs],
-            chart=shared,
-            ukc_m=ukc_m,
-            frame=frame,
-            pure=False,
-        )
+        # The encounters travel in the task graph (about 0.2 MB each), which distributed
+        # would warn about on stderr from 10 MB; scattering them first lost them now and
+        # then ("lost dependencies") on a two-worker LocalCluster.
+        with dask.config.set({"distributed.admin.large-graph-warning-threshold": "16GiB"}):
+            futures = client.map(
+                draw_encounter,
+                [outcome for outcome, _ in jobs],
+                [target for _, target in jobs],
+                chart=shared,
+                ukc_m=ukc_m,
+                frame=frame,
+                pure=False,
+            )
         for future in as_completed(futures, loop=client.loop):
             future.result()
             progress.advance()

@@ -3,7 +3,6 @@ number of workers, and clear errors."""
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -19,9 +18,6 @@ from fixture_files import NMEA
 
 
 def _replay(out: Path, *options: str) -> subprocess.CompletedProcess[str]:
-    # distributed warns on stderr of a task graph above this size: an encounter (about
-    # 0.2 MB) sent inside one would pass it.
-    env = {**os.environ, "DASK_DISTRIBUTED__ADMIN__LARGE_GRAPH_WARNING_THRESHOLD": "100kB"}
     return subprocess.run(
         [
             *(sys.executable, "-m", "colregs9_cli", "replay", str(NMEA), "--quiet"),
@@ -32,7 +28,6 @@ def _replay(out: Path, *options: str) -> subprocess.CompletedProcess[str]:
         capture_output=True,
         text=True,
         check=False,
-        env=env,
     )
 
 
