@@ -458,3 +458,13 @@ def test_ship_type_categories_are_one_spelling_whatever_the_case(tmp_path: Path)
     assert set(load_ais([path]).positions["ship_type"].dropna()) == set(
         load_ais([DMA26]).positions["ship_type"].dropna()
     )
+
+
+def test_an_error_quoting_a_row_with_line_breaks_is_one_line(tmp_path: Path) -> None:
+    lines = MARINECADASTRE.read_text(encoding="utf-8").splitlines()
+    path = tmp_path / "open_quote.csv"
+    path.write_text("\n".join([lines[0], '"' + lines[1], lines[1]]) + "\n")
+    with pytest.raises(InputFileError) as caught:
+        load_ais([path])
+    message = str(caught.value)
+    assert "\n" not in message and "a quote left open" in message and "\\n" in message

@@ -465,13 +465,23 @@ def _used_and_rejected(ledger: RejectsLedger) -> str:
     return f"{used}{ledger.rejected_total} rejected ({rejects})"
 
 
+# The longest reject example quoted in an error line.
+_EXAMPLE_CHARS = 300
+
+
 def _first_reject(ledger: RejectsLedger) -> str:
     """The first example of the most common reject: what the user most likely has to fix."""
     if not ledger.rejects:
         return ""
     reason = max(sorted(ledger.rejects), key=lambda r: ledger.rejects[r])
     examples = ledger.examples.get(reason)
-    return f"; the first {reason} row: {examples[0]}" if examples else ""
+    if not examples:
+        return ""
+    # One line: an example may quote a field that held line breaks.
+    example = examples[0].replace("\r", "\\r").replace("\n", "\\n")
+    if len(example) > _EXAMPLE_CHARS:
+        example = example[:_EXAMPLE_CHARS] + "…"
+    return f"; the first {reason} row: {example}"
 
 
 # -- one file ---------------------------------------------------------------------------------
