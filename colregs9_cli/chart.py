@@ -275,6 +275,12 @@ class _Features:
     purpose: int = 0  # navigational purpose, 1 overview … 6 berthing (DSID INTU); 0 unknown
     scale: float = math.inf  # compilation scale denominator (DSPM CSCL); inf unknown
 
+    def shapes(self) -> NDArray[np.object_]:
+        """Every geometry of the file, its coverage included: where it reaches."""
+        if self.coverage is None:
+            return self.geometries
+        return np.concatenate([self.geometries, np.asarray([self.coverage], dtype=object)])
+
 
 def _numeric(values: Any, path: Path, column: str) -> NDArray[np.float64]:
     try:
@@ -728,10 +734,7 @@ class ChartSource:
         lon = np.asarray(lon_deg, dtype=float)
         kept = []
         for features in self.features:
-            shapes = [features.geometries]
-            if features.coverage is not None:
-                shapes.append(np.asarray([features.coverage], dtype=object))
-            west, south, east, north = shapely.total_bounds(np.concatenate(shapes))
+            west, south, east, north = shapely.total_bounds(features.shapes())
             width = east - west + 2.0 * margin_deg
             # Eastwards from the widened west edge, round 180° if need be.
             along = np.mod(lon - (west - margin_deg), 360.0) <= width if width < 360.0 else True
@@ -742,11 +745,8 @@ class ChartSource:
 
     def bounds_wgs84(self) -> tuple[float, float, float, float]:
         """(lat_min, lat_max, lon_min, lon_max) of the charts' features and coverage."""
-        coverages = np.asarray(
-            [f.coverage for f in self.features if f.coverage is not None], dtype=object
-        )
         lon_min, lat_min, lon_max, lat_max = shapely.total_bounds(
-            np.concatenate([*(f.geometries for f in self.features), coverages])
+            np.concatenate([f.shapes() for f in self.features])
         )
         return float(lat_min), float(lat_max), float(lon_min), float(lon_max)
 
@@ -855,11 +855,7 @@ def _check_within_reach(source: ChartSource, frame: LocalFrame) -> None:
     ``FRAME_REACH_M`` of its centre; beyond, areas and ship domains would be stretched.
     Every vertex is checked, so that charts on both sides of 180° are judged as the frame
     (centred the short way round) sees them."""
-    shapes = [f.geometries for f in source.features]
-    shapes += [
-        np.asarray([f.coverage], dtype=object) for f in source.features if f.coverage is not None
-    ]
-    lon_lat = shapely.get_coordinates(np.concatenate(shapes))
+    lon_lat = shapely.get_coordinates(np.concatenate([f.shapes() for f in source.features]))
     if frame.within_reach(lon_lat[:, 1], lon_lat[:, 0]).all():
         return
     lat_min, lat_max, lon_min, lon_max = source.bounds_wgs84()
