@@ -4,13 +4,14 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator
+import sys
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from typer.core import TyperCommand
+from typer.core import TyperCommand, TyperGroup
 
 from . import __version__
 from .errors import Colregs9Error, OutputError
@@ -73,8 +74,46 @@ class _Command(TyperCommand):
                     formatter.write_dl(rows)
 
 
+class _App(TyperGroup):
+    """The command group, with Click's own errors (an unknown option, a missing argument, a
+    value that is not a number) as one ``Error:`` line like every other error, instead of
+    Click's usage block: the usage line, a hint and a blank line before the error."""
+
+    def main(  # type: ignore[override]
+        self,
+        args: Sequence[str] | None = None,
+        prog_name: str | None = None,
+        complete_var: str | None = None,
+        standalone_mode: bool = True,
+        **extra: Any,
+    ) -> Any:
+        arguments = sys.argv[1:] if args is None else list(args)
+        if not standalone_mode or not arguments:  # no arguments: the help, as Click shows it
+            return super().main(arguments, prog_name, complete_var, standalone_mode, **extra)
+        try:
+            status = super().main(arguments, prog_name, complete_var, False, **extra)
+        except typer.TyperException as exc:  # Click's exceptions derive from it
+            typer.echo(f"Error: {usage_error_line(exc)}", err=True)
+            sys.exit(exc.exit_code)
+        except typer.Abort:
+            typer.echo("Aborted!", err=True)
+            sys.exit(1)
+        # An explicit typer.Exit comes back as its status; a command's return value is None.
+        sys.exit(status if isinstance(status, int) else 0)
+
+
+def usage_error_line(exc: typer.TyperException) -> str:
+    """Click's error message on one line, with where to find the command's help."""
+    message = exc.format_message().replace("\r", "\\r").replace("\n", "\\n")
+    context = getattr(exc, "ctx", None)
+    if context is None:
+        return message
+    return f"{message} (see '{context.command_path} --help')"
+
+
 app = typer.Typer(
     name="colregs9",
+    cls=_App,
     help="COLREGs rule 9 (narrow channels) audits of historical AIS.",
     no_args_is_help=True,
     add_completion=False,
