@@ -10,9 +10,12 @@ b. ``ingest FILE --out DATASET`` once, then ``stats DATASET`` against ``stats FI
    against the same statistic in polars (``scan_parquet``) and duckdb over the dataset's
    Parquet files: per vessel the median length, breadth and draught of its rows (group by
    MMSI), then the count, mean, median, standard deviation, minimum and maximum over the
-   vessels. The four take turns ``--repeat`` times (round-robin, each round starting with the
-   next one); the table gives the best and median wall time and the median over rounds of
-   the time over the round's fastest. On the largest of ``--hours`` (``--stats-hours``);
+   vessels. Beside them, the floor of any ``stats`` command: a Python that only imports what
+   the command cannot do without (Typer, ``pyarrow.dataset``, which imports pandas itself,
+   and matplotlib's ``Figure`` for the histograms), and does nothing else. The five take
+   turns ``--repeat`` times (round-robin, each round starting with the next one); the table
+   gives the best and median wall time and the median over rounds of the time over the
+   round's fastest. On the largest of ``--hours`` (``--stats-hours``);
 c. ``replay --workers 1`` against ``--workers 2`` on the 6 h file (``--workers-hours``):
    wall time, peak RSS, and whether encounters.csv and pairs.csv are byte-identical;
 d. the cost of one figure: replay of the real 5-minute sample with and without plots
@@ -62,7 +65,9 @@ COLREGS9 = Path(sys.executable).with_name("colregs9")
 CLI: list[str] = [str(COLREGS9)]
 CODE: Path | None = None
 PARTS = ("replay", "stats", "workers", "figure")
-STATS_TOOLS = ("stats dataset", "stats CSV", "polars", "duckdb")
+STATS_TOOLS = ("stats dataset", "stats CSV", "polars", "duckdb", "imports alone")
+# What every ``colregs9 stats`` run imports before it reads a byte (see the docstring, b).
+STATS_FLOOR_IMPORTS = "import typer, pyarrow.dataset, matplotlib.figure"
 POLL_S = 0.1
 MB = 1024 * 1024
 
@@ -292,6 +297,8 @@ def _stats_command(tool: str, csv: str, dataset: Path, out: Path) -> list[str]:
         return [*CLI, "stats", str(dataset), "--quiet", "--out", str(out)]
     if tool == "stats CSV":
         return [*CLI, "stats", csv, "--quiet", "--out", str(out)]
+    if tool == "imports alone":
+        return [sys.executable, "-c", STATS_FLOOR_IMPORTS]
     return [sys.executable, __file__, "--child", tool, str(dataset)]
 
 
@@ -326,7 +333,8 @@ def bench_stats(day: dict[str, Any], work: Path, args: argparse.Namespace) -> di
     rounds: list[dict[str, tuple[Measured, dict[str, Any]]]] = []
     for n in range(args.repeat):
         measured_round = {}
-        for tool in STATS_TOOLS[n % 4 :] + STATS_TOOLS[: n % 4]:
+        turn = n % len(STATS_TOOLS)
+        for tool in STATS_TOOLS[turn:] + STATS_TOOLS[:turn]:
             out = _fresh(work / "stats_out")
             command = _stats_command(tool, day["path"], dataset, out)
             if tool in ("polars", "duckdb"):
@@ -352,6 +360,23 @@ def bench_stats(day: dict[str, Any], work: Path, args: argparse.Namespace) -> di
             "found": rounds[0][tool][1],
         }
     return {"hours": day["hours"], "ingest": ingest, "dataset_mb": size / 1e6, "tools": tools}
+
+
+def _print_stats_targets(tools: dict[str, dict[str, Any]]) -> None:
+    """Issue 15's two targets for ``stats``, by median wall times, and the floor beside."""
+    if any("status" in tools[t] for t in STATS_TOOLS):
+        return
+    median = {tool: t["median_s"] for tool, t in tools.items()}
+    engine = min(("polars", "duckdb"), key=median.__getitem__)
+    over_csv = median["stats CSV"] / median["stats dataset"]
+    over_engine = median["stats dataset"] / median[engine]
+    floor = median["imports alone"] / median[engine]
+    print(
+        f"\nTargets (issue 15), median walls: the dataset {over_csv:.1f}x faster than the CSV "
+        f"(>= 5x: {'met' if over_csv >= 5 else 'NOT met'}); {over_engine:.2f}x the fastest "
+        f"engine, {engine} (within 2x: {'met' if over_engine <= 2 else 'NOT met'}); the imports "
+        f"alone take {floor:.2f}x {engine}'s whole run."
+    )
 
 
 def _measure_engine(
@@ -492,6 +517,7 @@ def print_tables(
                     f"| {t['round_ratio']:.2f} | {t['rss_mb']:,.0f} MB "
                     f"| {f.get('vessels', '')} | {mean} |"
                 )
+            _print_stats_targets(stats["tools"])
     if workers is not None:
         print("\n### c. `replay --workers 1` against `--workers 2`\n")
         if isinstance(workers, str):
