@@ -239,10 +239,7 @@ def open_replay_input(
     datasets = [Path(p) for p in paths if Path(p).is_dir() and is_dataset(Path(p))]
     if len(paths) == 1 and datasets:
         dataset = Dataset.open(datasets[0])
-        inputs = tuple(
-            InputFile(Path(item.path), item.sha256, item.layout, item.rows_read, dataset.directory)
-            for item in dataset.inputs
-        )
+        inputs = InputFile.of_dataset(dataset)
         return _from_dataset(dataset, inputs, query, slab_s, columns)
     if not datasets and not any(Path(p).is_dir() for p in paths):
         ingested = ingest_with_query(paths, scratch / "ais-dataset", query, fmt, quiet)

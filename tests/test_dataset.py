@@ -545,3 +545,25 @@ def test_a_directory_of_dot_files_is_not_a_dataset(tmp_path: Path) -> None:
     result = CliRunner().invoke(app, ["ingest", str(DMA26), "--out", str(out), "--quiet"])
     assert result.exit_code == 2, result.output
     assert "holds files but no colregs9-dataset.json" in result.stderr
+
+
+@pytest.mark.parametrize("command", ["stats", "replay"])
+def test_a_report_on_a_dataset_names_the_query_it_was_ingested_through(
+    tmp_path: Path, command: str
+) -> None:
+    """The dataset holds only what its ingest query kept, so a report on it says which."""
+    dataset = tmp_path / "ais"
+    ingested = CliRunner().invoke(
+        app, ["ingest", str(NMEA), "--query", str(LIMFJORDEN), "--out", str(dataset), "--quiet"]
+    )
+    assert ingested.exit_code == 0, ingested.output
+    out = tmp_path / "report"
+    options = ["--no-plots"] if command == "replay" else []
+    result = CliRunner().invoke(
+        app, [command, str(dataset), "--out", str(out), "--quiet", *options]
+    )
+    assert result.exit_code == 0, result.output
+    (item,) = json.loads((out / "run.json").read_text())["inputs"]
+    assert item["dataset"] == str(dataset)
+    assert item["ingest_query"]["name"] == load_query(LIMFJORDEN).name
+    assert item["ingest_query"] == Dataset.open(dataset).inputs[0].entry["query"]

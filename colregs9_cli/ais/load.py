@@ -60,11 +60,11 @@ from __future__ import annotations
 
 import io
 import re
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol, TypeAlias
+from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 
 import numpy as np
 import pandas as pd
@@ -145,13 +145,31 @@ _SET_ASIDE_BYTES = 8 * 1024 * 1024
 @dataclass(frozen=True)
 class InputFile:
     """One input of a run; ``dataset``: the dataset it was read from (``colregs9 ingest``),
-    where ``path``, ``sha256`` and ``rows_read`` are those of the file ingested."""
+    where ``path``, ``sha256`` and ``rows_read`` are those of the file ingested, and
+    ``ingest_query`` the query it was ingested through (as its manifest records it): the
+    dataset holds only the rows that query kept."""
 
     path: Path
     sha256: str
     layout: str
     rows_read: int
     dataset: Path | None = None
+    ingest_query: Mapping[str, Any] | None = field(default=None, compare=False)
+
+    @classmethod
+    def of_dataset(cls, dataset: Dataset) -> tuple[InputFile, ...]:
+        """The inputs ingested into ``dataset``, as its manifest lists them."""
+        return tuple(
+            cls(
+                Path(item.path),
+                item.sha256,
+                item.layout,
+                item.rows_read,
+                dataset.directory,
+                item.entry.get("query"),
+            )
+            for item in dataset.inputs
+        )
 
 
 @dataclass(frozen=True)
@@ -397,10 +415,7 @@ def _dataset_inputs(dataset: Dataset, kept: int, ledger: RejectsLedger) -> tuple
     part.rows_used = dataset.static_rows
     part.outside_query(dataset.rows - dataset.static_rows - kept)
     ledger.merge(part)
-    return tuple(
-        InputFile(Path(item.path), item.sha256, item.layout, item.rows_read, dataset.directory)
-        for item in dataset.inputs
-    )
+    return InputFile.of_dataset(dataset)
 
 
 def _dataset_reports(dataset: Dataset, vessels: Sequence[int]) -> pa.Table:

@@ -107,14 +107,19 @@ def query_manifest(query: Query) -> dict[str, Any]:
 
 
 def inputs_manifest(inputs: Sequence[InputFile]) -> list[dict[str, Any]]:
-    """Each input file; one read from a dataset (``colregs9 ingest``) names it too."""
+    """Each input file; one read from a dataset (``colregs9 ingest``) names it too, with the
+    query it was ingested through."""
     return [
         {
             "path": str(item.path),
             "sha256": item.sha256,
             "layout": item.layout,
             "rows_read": item.rows_read,
-            **({"dataset": str(item.dataset)} if item.dataset is not None else {}),
+            **(
+                {"dataset": str(item.dataset), "ingest_query": jsonable(item.ingest_query)}
+                if item.dataset is not None
+                else {}
+            ),
         }
         for item in inputs
     ]
