@@ -64,6 +64,7 @@ from pyproj.exceptions import CRSError
 
 from .errors import ChartError, ParameterError
 from .geo import FRAME_REACH_M, LocalFrame
+from .s57_records import record_count
 from .s57_updates import update_files_beside
 
 HAZARD_RADIUS_M = 10.0
@@ -661,7 +662,9 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
             "and silently skip the rest. Put the missing update files beside the cell, or "
             "pass --accept-chart-gaps to use the cell as updated up to the gap"
         )
+    _check_whole_records(path, updates)
     fields = _dsid_fields(path)
+    _check_all_records(path, fields)
     _check_updates_applied(path, updates, missing, _whole_number(fields.get("DSID_UPDN")))
     _check_depth_unit(path, fields.get("DSPM_DUNI"))
     issue = fields.get("DSID_ISDT")
@@ -676,6 +679,40 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
         purpose=cell_purpose(fields.get("DSID_INTU"), path),
         scale=_whole_number(fields.get("DSPM_CSCL")),
     )
+
+
+def _check_whole_records(path: Path, updates: Sequence[Path]) -> None:
+    """Every record of the cell and its updates ends within its file (GDAL reads a file cut
+    inside a record up to the cut, or refuses it with a message about its leaders)."""
+    for file in (path, *updates):
+        if record_count(file) is None:
+            raise ChartError(
+                f"{file}: cut short or corrupt: a record of the file runs past its end or has "
+                "no length in its leader (ISO 8211); download the cell and its updates again"
+            )
+
+
+# DSSI's counts of the records of each kind: meta, cartographic, geo and collection feature
+# records, then isolated nodes, connected nodes, edges and faces.
+_DSSI_COUNTS = ("NOMR", "NOCR", "NOGR", "NOLR", "NOIN", "NOCN", "NOED", "NOFA")
+
+
+def _check_all_records(path: Path, fields: Mapping[str, Any]) -> None:
+    """The base cell holds every record its DSSI field lists, besides its data descriptive
+    record (GDAL reads a cell cut between two records without a word, the features of the
+    missing records gone)."""
+    counts = [_whole_number(fields.get(f"DSSI_{name}")) for name in _DSSI_COUNTS]
+    found = record_count(path)
+    if found is None or any(count is None for count in counts):
+        return
+    # The DSID record, and the DSPM record when there is one (its scale is mandatory).
+    has_dspm = bool(_whole_number(fields.get("DSPM_CSCL")))
+    listed = 1 + int(has_dspm) + sum(count or 0 for count in counts)
+    if found - 1 < listed:
+        raise ChartError(
+            f"{path}: cut short: its DSSI field lists {listed} records and the file holds "
+            f"{found - 1} (a download stopped early?); download the cell again"
+        )
 
 
 def _check_updates_applied(

@@ -16,8 +16,9 @@ from colregs9_cli.chart import project_charts, read_charts, s57_cell_info
 from colregs9_cli.cli import app
 from colregs9_cli.errors import ChartError
 from colregs9_cli.replay import run_replay
+from colregs9_cli.s57_records import record_count
 
-from fixture_files import SANDIEGO_AIS, SANDIEGO_ENC
+from fixture_files import ROOT, SANDIEGO_AIS, SANDIEGO_ENC
 
 
 def test_the_sandiego_cell_with_both_updates() -> None:
@@ -110,10 +111,13 @@ def test_replay_records_the_cells_in_run_json(tmp_path: Path, gap: Path) -> None
 def test_an_update_gdal_could_not_apply_is_an_error(
     tmp_path: Path, broken: str, applied: str
 ) -> None:
-    # GDAL skips a corrupt update and every later one without a word.
+    # GDAL skips a corrupt update and every later one without a word. This one has whole
+    # ISO 8211 record (the data descriptive record of another cell), so only GDAL can tell.
     for suffix in ("000", "001", "002"):
         shutil.copyfile(SANDIEGO_ENC.with_suffix(f".{suffix}"), tmp_path / f"US5CA72M.{suffix}")
-    (tmp_path / f"US5CA72M.{broken}").write_text("not an update\n")
+    (tmp_path / f"US5CA72M.{broken}").write_bytes(
+        ANNAPOLIS_ENC.read_bytes()[: _record_starts(ANNAPOLIS_ENC)[1]]
+    )
     with pytest.raises(ChartError, match=f"GDAL applied {applied}"):
         read_charts([tmp_path / "US5CA72M.000"])
 
@@ -141,3 +145,57 @@ def test_charts_beyond_the_reach_of_one_frame_are_refused() -> None:
     (near,) = source.near([32.7], [-117.2], margin_deg=0.25).paths
     assert near == SANDIEGO_ENC
     assert project_charts(source.near([32.7], [-117.2], margin_deg=0.25)).detail_order
+
+
+ANNAPOLIS_ENC = ROOT / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
+
+
+def _record_starts(path: Path) -> list[int]:
+    """Where each ISO 8211 record of ``path`` starts (each leader opens with its length)."""
+    data = path.read_bytes()
+    starts, position = [], 0
+    while position < len(data):
+        starts.append(position)
+        position += int(data[position : position + 5])
+    return starts
+
+
+def test_the_real_cells_hold_every_record_their_dssi_lists() -> None:
+    # Annapolis, by GDAL's DSSI: 37 meta and 3,252 geo feature records, 594 isolated and
+    # 3,897 connected nodes, 4,281 edges; with the DDR, DSID and DSPM records 12,064.
+    assert record_count(ANNAPOLIS_ENC) == len(_record_starts(ANNAPOLIS_ENC)) == 12_064
+    # San Diego: 54 + 7,472 + 5 feature records, 695 + 10,899 nodes, 11,246 edges, + 3.
+    assert record_count(SANDIEGO_ENC) == 30_374
+    assert [record_count(u) for u in s57_cell_info(SANDIEGO_ENC).update_files] == [38, 3]
+
+
+@pytest.mark.parametrize("kept", [0.05, 0.9, -1])
+def test_a_cell_cut_between_two_records_is_refused(tmp_path: Path, kept: float) -> None:
+    """GDAL reads it without a word: at 90 % of the records, 52 of the 249 depth areas."""
+    starts = _record_starts(ANNAPOLIS_ENC)
+    cut = starts[-1] if kept == -1 else starts[int(len(starts) * kept)]
+    cell = tmp_path / ANNAPOLIS_ENC.name
+    cell.write_bytes(ANNAPOLIS_ENC.read_bytes()[:cut])
+    listed = 12_063
+    with pytest.raises(ChartError, match=rf"cut short: its DSSI field lists {listed} records"):
+        read_charts([cell])
+
+
+def test_a_cell_cut_inside_a_record_is_refused(tmp_path: Path) -> None:
+    cell = tmp_path / ANNAPOLIS_ENC.name
+    cell.write_bytes(ANNAPOLIS_ENC.read_bytes()[:1_000_000])
+    with pytest.raises(ChartError, match=r"cut short or corrupt: a record of the file runs past"):
+        read_charts([cell])
+
+
+def test_an_update_cut_inside_a_record_is_refused(tmp_path: Path) -> None:
+    for suffix in ("000", "001", "002"):
+        shutil.copyfile(SANDIEGO_ENC.with_suffix(f".{suffix}"), tmp_path / f"US5CA72M.{suffix}")
+    update = tmp_path / "US5CA72M.001"
+    update.write_bytes(update.read_bytes()[:-10])
+    result = CliRunner().invoke(app, ["chart", str(tmp_path / "US5CA72M.000")])
+    assert result.exit_code == 2
+    assert result.stderr.strip().splitlines() == [
+        f"Error: {update}: cut short or corrupt: a record of the file runs past its end or has "
+        "no length in its leader (ISO 8211); download the cell and its updates again"
+    ]
