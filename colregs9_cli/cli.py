@@ -537,6 +537,8 @@ def ingest_command(
         fmt = _input_format(fmt, columns)
         result = ingest(ais, out, query_path=query, fmt=fmt, quiet=quiet)
     typer.echo(result.text, nl=False)
+    if not quiet:
+        typer.echo(f"Dataset in {result.out_dir}", err=True)
 
 
 @app.command("swing", cls=_Command)

@@ -210,8 +210,9 @@ def test_the_demo_names_its_files_where_they_are_after_the_swap(tmp_path: Path) 
         (["stats", str(DMA26), "--out", "OUT"], "Reports in OUT"),
         (["swing", "--out", "OUT"], "Reports in OUT"),
         (["simulate", "SCENARIO", "--out", "OUT/x.csv"], "AIS written to OUT/x.csv"),
+        (["ingest", str(DMA26), "--out", "OUT"], "Dataset in OUT"),
     ],
-    ids=["replay", "stats", "swing", "simulate"],
+    ids=["replay", "stats", "swing", "simulate", "ingest"],
 )
 def test_the_notice_of_what_was_written_is_on_stderr_and_quiet_drops_it(
     tmp_path: Path, command: list[str], notice: str
@@ -226,9 +227,11 @@ def test_the_notice_of_what_was_written_is_on_stderr_and_quiet_drops_it(
     assert loud.exit_code == 0, loud.output
     assert notice in loud.stderr and notice not in loud.stdout
     assert loud.stdout.strip(), "the results are on stdout"
-    quiet = _invoke(*args, "--quiet")
+    # Into another dataset: a second ingest of the same file into one adds nothing.
+    again = out + "-again" if command[0] == "ingest" else out
+    quiet = _invoke(*[a.replace(out, again) for a in args], "--quiet")
     assert quiet.exit_code == 0, quiet.output
-    assert quiet.stderr == "" and quiet.stdout == loud.stdout
+    assert quiet.stderr == "" and quiet.stdout == loud.stdout.replace(out, again)
 
 
 @pytest.mark.parametrize("command", ["stats", "replay"])
