@@ -694,3 +694,22 @@ def test_a_query_sets_the_precedence_and_the_ledger_records_it(tmp_path) -> None
     data = load_ais([log], query=arrival_first, fmt="nmea")
     assert data.positions["timestamp"].iloc[0] == datetime(2013, 11, 12, 13, 6, 40, tzinfo=UTC)
     assert data.ledger.to_dict()["time_source_order"] == ["arrival"]
+
+
+def test_an_invalid_mmsi_is_quoted_with_the_line_of_its_message(tmp_path: Path) -> None:
+    from colregs9_cli.ais.load import load_ais
+
+    log = tmp_path / "log.nmea"
+    lines = [
+        _at(0, _position()),
+        _at(1, _position(mmsi=2190045)),  # line 2: seven digits, not a ship's MMSI
+        *(_at(2, s) for s in _type5()),
+        *(_at(3, s) for s in _type5(mmsi=11388, seq_id=4)),  # lines 5-6: a static report
+    ]
+    log.write_text("\n".join(lines) + "\n")
+    ledger = load_ais([log]).ledger
+    assert dict(ledger.rejects) == {"invalid_mmsi": 2}
+    assert ledger.examples["invalid_mmsi"] == [
+        f"{log}:2: MMSI 2190045",
+        f"{log}:5: static report: MMSI 11388",
+    ]

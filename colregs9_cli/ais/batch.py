@@ -8,8 +8,9 @@ and also yields them in ``statics``, because per-vessel statistics count static 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
+import numpy as np
 import pyarrow as pa
 
 from .schema import CANONICAL_SCHEMA
@@ -36,6 +37,10 @@ STATIC_SCHEMA = pa.schema(
 class AisBatch:
     positions: pa.Table  # CANONICAL_SCHEMA
     statics: pa.Table  # STATIC_SCHEMA
+    # The line of the input each row of ``positions`` and ``statics`` comes from, where the
+    # reader knows it (NMEA: the first sentence of the message), for reject examples.
+    position_lines: np.ndarray | None = field(default=None, compare=False)
+    static_lines: np.ndarray | None = field(default=None, compare=False)
 
     def __post_init__(self) -> None:
         if not self.positions.schema.equals(CANONICAL_SCHEMA):

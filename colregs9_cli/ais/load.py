@@ -1071,14 +1071,17 @@ def _canonical_static_text(table: pa.Table) -> np.ndarray:
     return present
 
 
-def _table_example(name: str, table: pa.Table) -> Example:
+def _table_example(name: str, table: pa.Table, lines: np.ndarray | None = None) -> Example:
+    """Examples of rejected rows of ``table``, naming their ``lines`` where they are known."""
+
     def example(row: int, what: str, why: str) -> str:
         column = {"MMSI": "mmsi", "mobile": "mobile_type", "time": "timestamp"}.get(what, "lat_deg")
         value = table.column(column)[row].as_py()
         mmsi = table.column("mmsi")[row].as_py()
+        where = name if lines is None else f"{name}:{int(lines[row])}"
         if what == "MMSI":
-            return f"{name}: {why} {mmsi}"
-        return f"{name}: MMSI {mmsi}: {why} {value!r}"
+            return f"{where}: {why} {mmsi}"
+        return f"{where}: MMSI {mmsi}: {why} {value!r}"
 
     return example
 
@@ -1159,7 +1162,7 @@ def _nmea_batch(result: _FileResult, batch: AisBatch) -> None:
         result,
         _canonical_fields(positions),
         _taker(positions),
-        _table_example(result.name, positions),
+        _table_example(result.name, positions, batch.position_lines),
     )
     statics = batch.statics
     if statics.num_rows == 0:
@@ -1168,10 +1171,12 @@ def _nmea_batch(result: _FileResult, batch: AisBatch) -> None:
     bad = ~valid_mmsi(mmsi)
     if bad.any():
         first = int(np.flatnonzero(bad)[0])
+        lines = batch.static_lines
+        where = result.name if lines is None else f"{result.name}:{int(lines[first])}"
         result.ledger.reject(
             RejectReason.INVALID_MMSI,
             int(bad.sum()),
-            example=f"{result.name}: static report: MMSI {int(mmsi[first])}",
+            example=f"{where}: static report: MMSI {int(mmsi[first])}",
         )
     result.ledger.use(int((~bad).sum()))
     dimensions = DimensionColumns(statics.select(list(DIMENSIONS)), _canonical_dimensions)

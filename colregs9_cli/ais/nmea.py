@@ -783,4 +783,6 @@ def read_nmea(
     yield AisBatch(
         positions=_positions_table(reader.positions, position_statics, join_source),
         statics=_statics_table(statics),
+        position_lines=np.array(reader.positions.line_no, dtype=np.int64),
+        static_lines=np.array(reader.statics.line_no, dtype=np.int64),
     )
