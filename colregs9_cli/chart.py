@@ -65,7 +65,7 @@ from pyproj.exceptions import CRSError
 from .errors import ChartError, ParameterError
 from .geo import FRAME_REACH_M, LocalFrame
 from .s57_records import record_count
-from .s57_updates import update_files_beside
+from .s57_updates import applied_updates, update_files_beside
 
 HAZARD_RADIUS_M = 10.0
 # Depth areas that should meet often leave slivers of gap between them (or of land filling the
@@ -430,12 +430,14 @@ def _whole_number(value: Any) -> int | None:
     return int(value) if value is not None and str(value).strip().isdigit() else None
 
 
-def _dsid_fields(path: Path) -> dict[str, Any]:
-    """The DSID record of an S-57 cell (after its updates), or nothing when GDAL has none."""
+def _dsid_fields(path: Path, apply_updates: bool = True) -> dict[str, Any]:
+    """The DSID record of an S-57 cell (after its updates, unless not ``apply_updates``: the
+    file's own; an update file's own too), or nothing when GDAL has none."""
+    options = {**S57_OPEN_OPTIONS, "UPDATES": "APPLY" if apply_updates else "IGNORE"}
     try:
         with _gdal_quiet():
             meta, _, _, values = pyogrio.raw.read(
-                path, layer="DSID", read_geometry=False, **S57_OPEN_OPTIONS
+                path, layer="DSID", read_geometry=False, **options
             )
     except (DataSourceError, DataLayerError, FieldError, RuntimeError):
         return {}
@@ -663,6 +665,7 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
             "pass --accept-chart-gaps to use the cell as updated up to the gap"
         )
     _check_whole_records(path, updates)
+    _check_update_identities(path, applied_updates(updates, missing))
     fields = _dsid_fields(path)
     _check_all_records(path, fields)
     _check_updates_applied(path, updates, missing, _whole_number(fields.get("DSID_UPDN")))
@@ -689,6 +692,33 @@ def _check_whole_records(path: Path, updates: Sequence[Path]) -> None:
             raise ChartError(
                 f"{file}: cut short or corrupt: a record of the file runs past its end or has "
                 "no length in its leader (ISO 8211); download the cell and its updates again"
+            )
+
+
+def _check_update_identities(path: Path, updates: Sequence[Path]) -> None:
+    """Each update file GDAL applies is, by its own DSID, the update of this edition of this
+    cell that its name says: GDAL skips a stale, swapped or foreign update and every later
+    one without a word, and may take its update number, so that the check after reading
+    (``_check_updates_applied``) would blame the wrong file."""
+    if not updates:
+        return
+    base = _dsid_fields(path, apply_updates=False)
+    cell = Path(str(base.get("DSID_DSNM") or path.name)).stem
+    edition = _whole_number(base.get("DSID_EDTN"))
+    for update in updates:
+        own = _dsid_fields(update, apply_updates=False)
+        if not own:  # not readable as S-57: the check after reading names it
+            continue
+        name = Path(str(own.get("DSID_DSNM") or update.name)).stem
+        its_edition = _whole_number(own.get("DSID_EDTN"))
+        number = _whole_number(own.get("DSID_UPDN"))
+        expected = int(update.suffix[1:])
+        if (name, its_edition, number) != (cell, edition, expected):
+            raise ChartError(
+                f"{update}: by its DSID, update {number} of edition {its_edition} of cell "
+                f"{name}, not update {expected} of edition {edition} of {cell}; put update "
+                f"{expected} of this edition in its place, or move it and the later updates "
+                "away to use the cell as updated before it"
             )
 
 
@@ -720,8 +750,7 @@ def _check_updates_applied(
 ) -> None:
     """GDAL skips an update it cannot apply (corrupt, or of another edition) without a word;
     the cell's update number after reading tells."""
-    first_gap = min((int(name.rsplit(".", 1)[1]) for name in missing), default=None)
-    before_gap = [u for u in updates if first_gap is None or int(u.suffix[1:]) < first_gap]
+    before_gap = applied_updates(updates, missing)
     if not before_gap:
         return
     expected = int(before_gap[-1].suffix[1:])

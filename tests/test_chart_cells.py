@@ -199,3 +199,30 @@ def test_an_update_cut_inside_a_record_is_refused(tmp_path: Path) -> None:
         f"Error: {update}: cut short or corrupt: a record of the file runs past its end or has "
         "no length in its leader (ISO 8211); download the cell and its updates again"
     ]
+
+
+def test_swapped_updates_are_refused_naming_the_first_out_of_place(tmp_path: Path) -> None:
+    shutil.copyfile(SANDIEGO_ENC, tmp_path / "US5CA72M.000")
+    shutil.copyfile(SANDIEGO_ENC.with_suffix(".001"), tmp_path / "US5CA72M.002")
+    shutil.copyfile(SANDIEGO_ENC.with_suffix(".002"), tmp_path / "US5CA72M.001")
+    with pytest.raises(ChartError) as caught:
+        read_charts([tmp_path / "US5CA72M.000"])
+    assert str(caught.value).startswith(
+        f"{tmp_path / 'US5CA72M.001'}: by its DSID, update 2 of edition 56 of cell US5CA72M, "
+        "not update 1 of edition 56 of US5CA72M;"
+    )
+
+
+def test_an_update_of_another_cell_is_refused_naming_it(tmp_path: Path) -> None:
+    """GDAL took the foreign file's update number (0), which blamed .001 for .002."""
+    for suffix in ("000", "001"):
+        shutil.copyfile(SANDIEGO_ENC.with_suffix(f".{suffix}"), tmp_path / f"US5CA72M.{suffix}")
+    # The Annapolis cell's first records (DDR, DSID, DSPM) under the name of update 2.
+    foreign = tmp_path / "US5CA72M.002"
+    foreign.write_bytes(ANNAPOLIS_ENC.read_bytes()[: _record_starts(ANNAPOLIS_ENC)[3]])
+    with pytest.raises(ChartError) as caught:
+        read_charts([tmp_path / "US5CA72M.000"])
+    assert str(caught.value).startswith(
+        f"{foreign}: by its DSID, update 0 of edition 4 of cell US5MD1MC, not update 2 of "
+        "edition 56 of US5CA72M;"
+    )

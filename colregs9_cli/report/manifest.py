@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import pandas as pd
 
 from .. import __version__
-from ..s57_updates import update_files_beside
+from ..s57_updates import applied_updates, update_files_beside
 
 if TYPE_CHECKING:
     from ..ais.load import InputFile
@@ -69,14 +69,10 @@ def charts_manifest(
     charts = []
     for path in paths:
         updates, missing = update_files_beside(path) if path.suffix == ".000" else ([], [])
-        first_gap = min((int(name.rsplit(".", 1)[1]) for name in missing), default=None)
+        applied = applied_updates(updates, missing)
         files = [{"path": str(path), "sha256": _sha256(path), "applied": True}]
         files += [
-            {
-                "path": str(update),
-                "sha256": _sha256(update),
-                "applied": first_gap is None or int(update.suffix[1:]) < first_gap,
-            }
+            {"path": str(update), "sha256": _sha256(update), "applied": update in applied}
             for update in updates
         ]
         charts.append(
