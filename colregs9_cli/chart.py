@@ -161,9 +161,14 @@ class Chart:
             raise ParameterError(f"under-keel clearance {ukc_m} m is negative; give a UKC >= 0")
         key = (float(draught_m), float(ukc_m))
         if key not in self._water:
-            required_m = draught_m + ukc_m
+            # To the micrometre: 8.8 + 0.3 is 9.100000000000001 in binary, which left out
+            # the areas charted exactly 9.1 m deep.
+            required_m = round(draught_m + ukc_m, 6)
             deep = shapely.union_all(self.depth_areas[self.drval1_m >= required_m])
-            water = _close_slivers(shapely.difference(deep, self.land))
+            # Depth areas outside a cell's stated coverage (M_COVR) are not charted water;
+            # the seams the coverage may share with them are closed after.
+            charted = shapely.intersection(shapely.difference(deep, self.land), self.coverage)
+            water = _close_slivers(charted)
             blocking = self._blocking_hazards(required_m)
             if not shapely.is_empty(blocking):
                 water = shapely.difference(water, blocking)
@@ -463,6 +468,8 @@ def _read_vector(path: Path) -> _Features:
         columns = meta["columns"]
         if layer.upper() == "DSID":
             _dsid_detail(columns, detail)
+            duni = columns.get("DSPM_DUNI")
+            _check_depth_unit(path, duni[0] if duni is not None and len(duni) else None)
             continue
         if len(geometries) == 0:
             continue
@@ -839,7 +846,10 @@ def _project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
     projected = shapely.transform(geometries, lonlat_to_east_north)
     invalid = ~shapely.is_valid(projected)
     if invalid.any():
-        projected[invalid] = shapely.make_valid(projected[invalid])
+        # A ring with a spike is repaired into its area and a line: keep the area.
+        projected[invalid] = _same_dimension(
+            shapely.make_valid(projected[invalid]), projected[invalid]
+        )
     return projected
 
 
@@ -962,6 +972,12 @@ def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Char
     polygonal = np.isin(shapely.get_type_id(geometries), _POLYGONAL)
 
     depth = np.isin(role, [ChartLayer.DEPARE, ChartLayer.DRGARE]) & polygonal
+    if not depth.any():
+        names = ", ".join(str(f.path) for f in features)
+        raise ChartError(
+            f"{names}: no depth area is left where each chart decides (a more detailed chart's "
+            "coverage holds none); give charts with depth areas inside their coverage"
+        )
     land_areas = (role == ChartLayer.LNDARE) & polygonal
     # Land charted as a point or line (an islet, a pier) is a hazard at any depth.
     small_land = (role == ChartLayer.LNDARE) & ~polygonal

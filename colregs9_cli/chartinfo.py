@@ -219,6 +219,10 @@ def summarise_chart(
     """
     _check_depth("draught", draught_m, MAX_DRAUGHT_M)
     _check_depth("ukc", ukc_m, MAX_UKC_M)
+    if draught_m is None and ukc_m:
+        raise ParameterError(
+            f"--ukc {ukc_m:g} needs --draught M: the clearance is added to a draught; add --draught"
+        )
     check_chart_out(out, draught_m)
     with progress_bar("Reading charts", 1, progress_enabled(quiet)) as bar:
         chart = load_chart(paths, accept_gaps=accept_gaps)
