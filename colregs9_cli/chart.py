@@ -103,6 +103,11 @@ _OBJECT_CLASSES: dict[str, tuple[int, ChartLayer]] = {
     "UWTROC": (153, ChartLayer.HAZARD),
 }
 _ACRONYM_BY_CODE = {code: name for name, (code, _) in _OBJECT_CLASSES.items()}
+_BLOCKING_CLASSES = [
+    name
+    for name, (_, role) in _OBJECT_CLASSES.items()
+    if role in (ChartLayer.LNDARE, ChartLayer.HAZARD)
+]
 _POLYGONAL = (shapely.GeometryType.POLYGON, shapely.GeometryType.MULTIPOLYGON)
 
 
@@ -594,7 +599,17 @@ def _assemble(
         np.concatenate(drval2),
         np.concatenate(valsou),
     )
-    keep = ~shapely.is_missing(features.geometries) & (features.object_class != None)  # noqa: E711
+    missing = shapely.is_missing(features.geometries)
+    # Land or a hazard without a geometry would leave water where there is none.
+    blocking = missing & np.isin(features.object_class, _BLOCKING_CLASSES)
+    if blocking.any():
+        first = features.object_class[blocking][0]
+        raise ChartError(
+            f"{path}: {int(blocking.sum())} land or hazard feature(s) ({first} first) have no "
+            "geometry GDAL could read; give each its geometry (a Polygon, LineString or Point "
+            "in the file's coordinates), or leave the feature out"
+        )
+    keep = ~missing & (features.object_class != None)  # noqa: E711
     return _Features(
         path,
         features.geometries[keep],

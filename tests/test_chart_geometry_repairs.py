@@ -163,3 +163,26 @@ def test_a_clearance_without_a_draught_is_refused() -> None:
     assert result.stderr.strip().splitlines() == [
         "Error: --ukc 2 needs --draught M: the clearance is added to a draught; add --draught"
     ]
+
+
+@pytest.mark.parametrize(
+    "geometry",
+    [
+        {"type": "Polgon", "coordinates": [[[10.5, 57.0], [10.51, 57.0], [10.5, 57.01]]]},
+        {"type": "Polygon", "coordinates": [10.5, 57.0]},
+        None,
+    ],
+    ids=["misspelt type", "wrong nesting", "null"],
+)
+def test_land_without_a_readable_geometry_is_refused(
+    tmp_path: Path, geometry: dict[str, Any] | None
+) -> None:
+    """GDAL reads such land as no geometry (and warns, quietly): the water would run over it."""
+    path = _chart(tmp_path / "land.geojson", [(DEEP, _box(0, 0, KM, KM))])
+    collection = json.loads(path.read_text())
+    collection["features"].append(
+        {"type": "Feature", "properties": {"OBJL": "LNDARE"}, "geometry": geometry}
+    )
+    path.write_text(json.dumps(collection))
+    with pytest.raises(ChartError, match=r"1 land or hazard feature\(s\) \(LNDARE first\)"):
+        load_chart([path], frame=FRAME)
