@@ -686,10 +686,10 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
             "and silently skip the rest. Put the missing update files beside the cell, or "
             "pass --accept-chart-gaps to use the cell as updated up to the gap"
         )
-    _check_whole_records(path, updates)
+    records = _whole_records(path, updates)
     _check_update_identities(path, applied_updates(updates, missing))
     fields = _dsid_fields(path)
-    _check_all_records(path, fields)
+    _check_all_records(path, records, fields)
     _check_updates_applied(path, updates, missing, _whole_number(fields.get("DSID_UPDN")))
     _check_depth_unit(path, fields.get("DSPM_DUNI"))
     issue = fields.get("DSID_ISDT")
@@ -706,15 +706,24 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
     )
 
 
-def _check_whole_records(path: Path, updates: Sequence[Path]) -> None:
-    """Every record of the cell and its updates ends within its file (GDAL reads a file cut
-    inside a record up to the cut, or refuses it with a message about its leaders)."""
-    for file in (path, *updates):
-        if record_count(file) is None:
-            raise ChartError(
-                f"{file}: cut short or corrupt: a record of the file runs past its end or has "
-                "no length in its leader (ISO 8211); download the cell and its updates again"
-            )
+def _whole_records(path: Path, updates: Sequence[Path]) -> int:
+    """The number of records of the base cell, once every record of the cell and its updates
+    is found to end within its file (GDAL reads a file cut inside a record up to the cut, or
+    refuses it with a message about its leaders)."""
+    found = _records_of(path)
+    for update in updates:
+        _records_of(update)
+    return found
+
+
+def _records_of(file: Path) -> int:
+    count = record_count(file)
+    if count is None:
+        raise ChartError(
+            f"{file}: cut short or corrupt: a record of the file runs past its end or has "
+            "no length in its leader (ISO 8211); download the cell and its updates again"
+        )
+    return count
 
 
 def _check_update_identities(path: Path, updates: Sequence[Path]) -> None:
@@ -749,13 +758,12 @@ def _check_update_identities(path: Path, updates: Sequence[Path]) -> None:
 _DSSI_COUNTS = ("NOMR", "NOCR", "NOGR", "NOLR", "NOIN", "NOCN", "NOED", "NOFA")
 
 
-def _check_all_records(path: Path, fields: Mapping[str, Any]) -> None:
+def _check_all_records(path: Path, found: int, fields: Mapping[str, Any]) -> None:
     """The base cell holds every record its DSSI field lists, besides its data descriptive
     record (GDAL reads a cell cut between two records without a word, the features of the
     missing records gone)."""
     counts = [_whole_number(fields.get(f"DSSI_{name}")) for name in _DSSI_COUNTS]
-    found = record_count(path)
-    if found is None or any(count is None for count in counts):
+    if any(count is None for count in counts):
         return
     # The DSID record, and the DSPM record when there is one (its scale is mandatory).
     has_dspm = bool(_whole_number(fields.get("DSPM_CSCL")))

@@ -102,9 +102,14 @@ class _App(TyperGroup):
         sys.exit(status if isinstance(status, int) else 0)
 
 
+def _one_line(message: str) -> str:
+    """An error message on one line, whatever a file name or a value in it holds."""
+    return message.replace("\r", "\\r").replace("\n", "\\n")
+
+
 def usage_error_line(exc: typer.TyperException) -> str:
     """Click's error message on one line, with where to find the command's help."""
-    message = exc.format_message().replace("\r", "\\r").replace("\n", "\\n")
+    message = _one_line(exc.format_message())
     context = getattr(exc, "ctx", None)
     if context is None:
         return message
@@ -140,9 +145,7 @@ def _user_errors() -> Iterator[None]:
     try:
         yield
     except Colregs9Error as exc:
-        # One line, whatever a file name or a value in the message holds.
-        message = str(exc).replace("\r", "\\r").replace("\n", "\\n")
-        typer.echo(f"Error: {message}", err=True)
+        typer.echo(f"Error: {_one_line(str(exc))}", err=True)
         raise typer.Exit(exc.exit_code) from None
 
 
