@@ -19,11 +19,11 @@ from pathlib import Path
 import pandas as pd
 
 from .ais.load import count_ais, load_ais
-from .dimensions import GroupBy, Per, dimension_stats
+from .core.dimensions import GroupBy, Per, dimension_stats
+from .core.replay_results import ReplayResult
 from .errors import ParameterError
+from .jobs.replay import run_replay
 from .query import everything_query, load_query
-from .replay import run_replay
-from .replay_results import ReplayResult
 
 PathLike = str | Path
 

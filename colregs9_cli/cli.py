@@ -325,7 +325,7 @@ def replay_command(
     Example:
       colregs9 replay fixtures/ais/dma_nmea_2013-11-12_5min.txt.gz --no-plots
     """
-    from .replay import run_replay
+    from .jobs.replay import run_replay
 
     with _user_errors():
         fmt = _input_format(fmt, columns)
@@ -389,7 +389,7 @@ def simulate_command(
     Example:
       colregs9 simulate colregs9_cli/data/demo/greenhopper_restricted.toml
     """
-    from .simulate import simulate_scenario
+    from .jobs.simulate import simulate_scenario
 
     with _user_errors():
         result = simulate_scenario(scenario, _out_file(out), quiet=quiet)
@@ -463,7 +463,7 @@ def stats_command(
     Example:
       colregs9 stats fixtures/ais/aisdk_2024-09-09_sample.csv --by ship_type
     """
-    from .stats import run_stats
+    from .jobs.stats import run_stats
 
     with _user_errors():
         fmt = _input_format(fmt, columns)
@@ -534,7 +534,7 @@ def ingest_command(
       colregs9 ingest fixtures/ais/aisdk_2024-09-09_sample.csv \\
           --out reports/ais-dataset
     """
-    from .ais.dataset import ingest
+    from .jobs.ingest import ingest
 
     with _user_errors():
         fmt = _input_format(fmt, columns)
@@ -563,7 +563,7 @@ def swing_command(
     Example:
       colregs9 swing --out reports/swing
     """
-    from .swing import run_swing
+    from .jobs.swing import run_swing
 
     with _user_errors():
         report = run_swing(out, overwrite=overwrite)
@@ -618,7 +618,7 @@ def chart_command(
     Example:
       colregs9 chart fixtures/charts/noaa_enc_US5MD1MC.000 --draught 5
     """
-    from .chartinfo import summarise_chart
+    from .jobs.chartinfo import summarise_chart
 
     with _user_errors():
         summary = summarise_chart(
@@ -679,7 +679,7 @@ def demo_command(
     Example:
       colregs9 demo --out reports/demo
     """
-    from .demo import DEFAULT_CHART, DEFAULT_QUERY, DEFAULT_SCENARIOS_DIR, run_demo
+    from .jobs.demo import DEFAULT_CHART, DEFAULT_QUERY, DEFAULT_SCENARIOS_DIR, run_demo
 
     with _user_errors():
         result = run_demo(

@@ -1,6 +1,6 @@
 """Regenerate the Greenhopper golden files and the committed example figures.
 
-Runs the demo (``colregs9_cli.demo.run_demo``: simulate and replay both scenarios, own ship
+Runs the demo (``colregs9_cli.jobs.demo.run_demo``: simulate and replay both scenarios, own ship
 the Greenhopper) in a temporary directory, then copies for each scenario:
 
 - its ``encounters.csv`` to ``tests/golden/<scenario>_encounters.csv`` (what
@@ -19,7 +19,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from colregs9_cli.demo import run_demo
+from colregs9_cli.jobs.demo import run_demo
 from colregs9_cli.report.replay_report import ENCOUNTERS_NAME
 
 ROOT = Path(__file__).resolve().parents[1]

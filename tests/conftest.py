@@ -24,7 +24,7 @@ def fixtures_dir() -> Path:
 def sandiego_replay(tmp_path_factory: pytest.TempPathFactory):
     """The San Diego replay on its ENC without figures, shared by the modules that read it
     (read only: no test writes into its report)."""
-    from colregs9_cli.replay import run_replay
+    from colregs9_cli.jobs.replay import run_replay
 
     out = tmp_path_factory.mktemp("sandiego")
     return run_replay([SANDIEGO_AIS], chart_paths=[SANDIEGO_ENC], out_dir=out, plots=False)

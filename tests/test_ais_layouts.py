@@ -16,10 +16,10 @@ import pyarrow as pa
 import pytest
 
 from colregs9_cli.ais.column_map import load_column_map, map_layout
-from colregs9_cli.ais.dataset import ingest
 from colregs9_cli.ais.load import load_ais
 from colregs9_cli.errors import InputFileError, ParameterError
-from colregs9_cli.stats import run_stats
+from colregs9_cli.jobs.ingest import ingest
+from colregs9_cli.jobs.stats import run_stats
 
 from fixture_files import AIS_FIXTURES, DMA26, MARINECADASTRE, NMEA, ROOT
 

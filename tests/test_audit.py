@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from colregs9_cli.audit import (
+from colregs9_cli.core.audit import (
     Action,
     ConductParams,
     Fact,

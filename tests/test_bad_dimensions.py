@@ -15,9 +15,9 @@ import pytest
 
 from colregs9_cli.ais.load import load_ais
 from colregs9_cli.ais.schema import CANONICAL_SCHEMA
-from colregs9_cli.replay import run_replay
-from colregs9_cli.stats import run_stats
-from colregs9_cli.vessel_defaults import vessel_dimensions
+from colregs9_cli.core.vessel_defaults import vessel_dimensions
+from colregs9_cli.jobs.replay import run_replay
+from colregs9_cli.jobs.stats import run_stats
 
 from fixture_files import AIS_FIXTURES, DMA26, MARINECADASTRE, ROOT
 
@@ -326,7 +326,7 @@ def test_stats_counts_the_implausible_dimension_of_each_reader(tmp_path: Path, m
 
 
 def test_a_dataset_keeps_the_count_of_its_inputs(tmp_path: Path) -> None:
-    from colregs9_cli.ais.dataset import ingest
+    from colregs9_cli.jobs.ingest import ingest
 
     path = _with_length(tmp_path, "900")
     ingest([path], tmp_path / "ais")

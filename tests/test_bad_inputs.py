@@ -383,7 +383,7 @@ def _charts(work: Path) -> dict[str, str]:
 def _datasets(work: Path) -> dict[str, str]:
     """Datasets made by ``ingest`` (in-process), then spoilt: a foreign Parquet file beside
     the partitions, and a partition rewritten with another schema."""
-    from colregs9_cli.ais.dataset import ingest
+    from colregs9_cli.jobs.ingest import ingest
 
     made = work / "datasets" / "good"
     foreign = work / "datasets" / "foreign"

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from colregs9_cli.ais.load import load_ais
-from colregs9_cli.replay import run_replay
+from colregs9_cli.jobs.replay import run_replay
 
 from fixture_files import DMA26
 

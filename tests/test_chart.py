@@ -17,10 +17,10 @@ import pytest
 import shapely
 from pyogrio.raw import read, write
 
-from colregs9_cli.chart import HAZARD_RADIUS_M, Chart, load_chart, read_charts
+from colregs9_cli.charts.chart import HAZARD_RADIUS_M, Chart, load_chart, read_charts
+from colregs9_cli.core.manoeuvrability import ManoeuvrabilityParams, assess_manoeuvrability
 from colregs9_cli.errors import ChartError, ParameterError
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.manoeuvrability import ManoeuvrabilityParams, assess_manoeuvrability
 from colregs9_cli.report.chart_plot import draw_assessment, draw_chart
 
 ENC = Path(__file__).resolve().parents[1] / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"

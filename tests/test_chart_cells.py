@@ -12,11 +12,11 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from colregs9_cli.chart import project_charts, read_charts, s57_cell_info
+from colregs9_cli.charts.chart import project_charts, read_charts, s57_cell_info
+from colregs9_cli.charts.s57_records import record_count
 from colregs9_cli.cli import app
 from colregs9_cli.errors import ChartError
-from colregs9_cli.replay import run_replay
-from colregs9_cli.s57_records import record_count
+from colregs9_cli.jobs.replay import run_replay
 
 from fixture_files import ROOT, SANDIEGO_AIS, SANDIEGO_ENC
 

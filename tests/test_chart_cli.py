@@ -148,7 +148,7 @@ def test_an_out_under_a_file_is_refused(tmp_path: Path) -> None:
 
 
 def test_the_chart_plot_outlines_the_coverage(tmp_path: Path) -> None:
-    from colregs9_cli.chart import load_chart
+    from colregs9_cli.charts.chart import load_chart
     from colregs9_cli.report.chart_plot import draw_chart
 
     chart = load_chart([ENC])
@@ -177,7 +177,7 @@ def test_the_depths_are_banded_around_the_draught(draught_m: float) -> None:
     than the draught, pale blue where it is deeper, with a band edge at the draught."""
     from matplotlib.colors import BoundaryNorm, to_hex
 
-    from colregs9_cli.chart import load_chart
+    from colregs9_cli.charts.chart import load_chart
     from colregs9_cli.report.chart_plot import DEEP_COLOURS, SHALLOW_COLOURS, draw_chart
 
     chart = load_chart([ENC])

@@ -11,7 +11,7 @@ import pyogrio
 import pytest
 import shapely
 
-from colregs9_cli.chart import (
+from colregs9_cli.charts.chart import (
     S57_OPEN_OPTIONS,
     Chart,
     cell_purpose,

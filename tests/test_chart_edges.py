@@ -10,10 +10,14 @@ import numpy as np
 import pytest
 import shapely
 
-from colregs9_cli.chart import Chart, ChartLayer, load_chart, read_charts
+from colregs9_cli.charts.chart import Chart, ChartLayer, load_chart, read_charts
+from colregs9_cli.core.manoeuvrability import (
+    ManoeuvrabilityParams,
+    Restriction,
+    assess_manoeuvrability,
+)
 from colregs9_cli.errors import ChartError
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.manoeuvrability import ManoeuvrabilityParams, Restriction, assess_manoeuvrability
 
 FRAME = LocalFrame(57.0, 10.0)
 PARAMS = ManoeuvrabilityParams()
@@ -173,7 +177,7 @@ def _box_chart(path: Path, west: float, east: float) -> Path:
 
 
 def test_cells_on_both_sides_of_180_are_one_area(tmp_path: Path) -> None:
-    from colregs9_cli.chart import project_charts
+    from colregs9_cli.charts.chart import project_charts
 
     east = _box_chart(tmp_path / "east.geojson", 179.8, 180.0)
     west = _box_chart(tmp_path / "west.geojson", -180.0, -179.8)

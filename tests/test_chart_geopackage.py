@@ -14,8 +14,8 @@ import pytest
 import shapely
 from pyproj import Geod
 
-from colregs9_cli.chart import load_chart
-from colregs9_cli.chartinfo import summarise_chart
+from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.jobs.chartinfo import summarise_chart
 
 from fixture_files import SANDIEGO_ENC
 

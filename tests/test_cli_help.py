@@ -170,7 +170,7 @@ def test_ais_commands_name_every_input_format_and_layout(name: str) -> None:
     [("replay", "--chart CHART"), ("chart", "CHART..."), ("demo", "--chart CHART")],
 )
 def test_chart_inputs_name_every_chart_format(name: str, marker: str) -> None:
-    from colregs9_cli.chart import S57_SUFFIXES, VECTOR_SUFFIXES
+    from colregs9_cli.charts.chart import S57_SUFFIXES, VECTOR_SUFFIXES
 
     output = " ".join(_help([name]).split())
     chart_help = output.split(marker, 1)[1].split(" --", 1)[0]

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from colregs9_cli.colregs import (
+from colregs9_cli.core.colregs import (
     ColregsParams,
     Kinematics,
     Role,
@@ -18,8 +18,8 @@ from colregs9_cli.colregs import (
     evaluate_colregs,
     relative_bearing_deg,
 )
+from colregs9_cli.core.replay_params import CourseSource
 from colregs9_cli.errors import ParameterError, QueryError
-from colregs9_cli.replay_params import CourseSource
 
 PARAMS = ColregsParams()
 EPS = 1e-6

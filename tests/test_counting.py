@@ -15,13 +15,13 @@ from typer.testing import CliRunner
 
 from colregs9_cli.ais import counting
 from colregs9_cli.ais.counting import RowCounts, row_runs
-from colregs9_cli.ais.dataset import ingest, ingest_with_query
 from colregs9_cli.ais.dataset_count import DatasetCounts, count_dataset
 from colregs9_cli.ais.dataset_scan import Dataset
 from colregs9_cli.ais.duplicates import ROW_ORDER, repeated_rows
 from colregs9_cli.ais.load import count_ais, load_ais
 from colregs9_cli.cli import app
 from colregs9_cli.errors import NoDataError
+from colregs9_cli.jobs.ingest import ingest, ingest_with_query
 from colregs9_cli.query import Query, Region, everything_query
 
 from fixture_files import DMA22, DMA26

@@ -11,8 +11,8 @@ import pyogrio
 import pytest
 from typer.testing import CliRunner
 
-from colregs9_cli import dask_run
 from colregs9_cli.cli import app
+from colregs9_cli.jobs import dask_run
 
 from fixture_files import NMEA
 

@@ -18,17 +18,17 @@ import pytest
 from typer.testing import CliRunner
 
 from colregs9_cli.ais import counting
-from colregs9_cli.ais.dataset import (
-    dataset_time_range,
-    ingest,
-    is_dataset,
-    read_dataset_window,
-)
 from colregs9_cli.ais.dataset_scan import MANIFEST_NAME, Dataset, position_filter
 from colregs9_cli.ais.load import AisData, count_ais, load_ais
 from colregs9_cli.ais.schema import CANONICAL_SCHEMA, STATS_POSITION_COLUMNS
 from colregs9_cli.cli import app
 from colregs9_cli.errors import InputFileError, NoDataError
+from colregs9_cli.jobs.ingest import (
+    dataset_time_range,
+    ingest,
+    is_dataset,
+    read_dataset_window,
+)
 from colregs9_cli.query import Query, Region, TimeWindow, VesselFilter, load_query
 
 from fixture_files import DMA22, DMA26, MARINECADASTRE, NMEA, ROOT

@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from pyproj import Geod
 
-from colregs9_cli import encounters as encounters_module
-from colregs9_cli.encounters import (
+from colregs9_cli.core import encounters as encounters_module
+from colregs9_cli.core.encounters import (
     SERIES_VESSEL_COLUMNS,
     candidate_pairs,
     cpa_tcpa,
@@ -21,10 +21,10 @@ from colregs9_cli.encounters import (
     trigger_mask,
     velocity_mps,
 )
+from colregs9_cli.core.replay_params import ReplayParams, replay_params_from_table
+from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.errors import NoDataError, ParameterError, QueryError
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.replay_params import ReplayParams, replay_params_from_table
-from colregs9_cli.tracks import build_tracks
 from colregs9_cli.units import (
     knots_to_mps,
     metres_to_nautical_miles,

@@ -16,11 +16,11 @@ import pytest
 import shapely
 from pyproj import Geod
 
-from colregs9_cli.encounters import find_encounters
+from colregs9_cli.core.encounters import find_encounters
+from colregs9_cli.core.replay_params import ReplayParams
+from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.replay import run_replay
-from colregs9_cli.replay_params import ReplayParams
-from colregs9_cli.tracks import build_tracks
+from colregs9_cli.jobs.replay import run_replay
 
 GEOD = Geod(ellps="WGS84")
 T0 = pd.Timestamp("2024-01-01T00:00:00Z")

@@ -20,14 +20,14 @@ import pytest
 import shapely
 from typer.testing import CliRunner
 
-from colregs9_cli.chart import load_chart
+from colregs9_cli.charts.chart import load_chart
 from colregs9_cli.cli import app
-from colregs9_cli.demo import run_scenario
+from colregs9_cli.core.manoeuvrability import Restriction, ellipse_polygons
+from colregs9_cli.core.replay_results import ReplayResult
 from colregs9_cli.errors import InputFileError, NoDataError
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.manoeuvrability import Restriction, ellipse_polygons
-from colregs9_cli.replay import run_replay
-from colregs9_cli.replay_results import ReplayResult
+from colregs9_cli.jobs.demo import run_scenario
+from colregs9_cli.jobs.replay import run_replay
 from colregs9_cli.units import knots_to_mps
 
 from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, ROOT, SCENARIOS

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from colregs9_cli.replay import run_replay
+from colregs9_cli.jobs.replay import run_replay
+from colregs9_cli.jobs.stats import run_stats
 from colregs9_cli.report.html_report import ENCOUNTER_TABLE_COLUMNS, pair_numbers
-from colregs9_cli.stats import run_stats
 
 from fixture_files import DMA26, NMEA
 

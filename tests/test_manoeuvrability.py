@@ -12,10 +12,8 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from colregs9_cli.chart import Chart, ChartLayer, load_chart
-from colregs9_cli.errors import ParameterError, QueryError
-from colregs9_cli.geo import LocalFrame
-from colregs9_cli.manoeuvrability import (
+from colregs9_cli.charts.chart import Chart, ChartLayer, load_chart
+from colregs9_cli.core.manoeuvrability import (
     ManoeuvrabilityParams,
     Restriction,
     RestrictionPolicy,
@@ -28,6 +26,8 @@ from colregs9_cli.manoeuvrability import (
     turning_arcs,
     verdict,
 )
+from colregs9_cli.errors import ParameterError, QueryError
+from colregs9_cli.geo import LocalFrame
 
 ENC = Path(__file__).resolve().parents[1] / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
 SEVEN_KN_MPS = 7.0 * 1852.0 / 3600.0

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
 from colregs9_cli.errors import OutputError
-from colregs9_cli.report.atomic import check_out_dir, report_directory, write_text
+from colregs9_cli.outputs import check_out_dir, report_directory, write_text
 
 from fixture_files import DMA26, NMEA
 
@@ -238,7 +238,7 @@ def test_the_notice_of_what_was_written_is_on_stderr_and_quiet_drops_it(
 def test_an_out_that_holds_an_input_is_refused_even_with_overwrite(
     tmp_path: Path, command: str
 ) -> None:
-    from colregs9_cli.ais.dataset import ingest
+    from colregs9_cli.jobs.ingest import ingest
 
     given = tmp_path / DMA26.name
     given.write_bytes(DMA26.read_bytes())
@@ -254,7 +254,7 @@ def test_an_out_that_holds_an_input_is_refused_even_with_overwrite(
 
 
 def test_a_file_its_writer_made_again_follows_the_umask(tmp_path: Path) -> None:
-    from colregs9_cli.report.atomic import atomic_path
+    from colregs9_cli.outputs import atomic_path
 
     previous = os.umask(0o002)
     try:

@@ -6,8 +6,8 @@ from contextlib import contextmanager
 
 import pytest
 
-import colregs9_cli.ais.dataset as dataset
-import colregs9_cli.replay as replay
+import colregs9_cli.jobs.ingest as dataset
+import colregs9_cli.jobs.replay as replay
 from colregs9_cli.progress import progress_bar
 
 from fixture_files import NMEA

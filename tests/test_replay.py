@@ -22,19 +22,19 @@ from pyproj import Geod, Transformer
 
 from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
-from colregs9_cli.chart import load_chart
-from colregs9_cli.errors import ParameterError
-from colregs9_cli.manoeuvrability import (
+from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.core.manoeuvrability import (
     RestrictionPolicy,
     SwingModel,
     target_rate_of_swing_deg_per_m,
     verdict,
 )
+from colregs9_cli.core.replay_params import ReplayParams
+from colregs9_cli.core.replay_results import ENCOUNTER_COLUMNS, PAIR_COLUMNS
+from colregs9_cli.errors import ParameterError
+from colregs9_cli.jobs.replay import run_params, run_replay
+from colregs9_cli.jobs.simulate import simulate_scenario
 from colregs9_cli.query import everything_query
-from colregs9_cli.replay import run_params, run_replay
-from colregs9_cli.replay_params import ReplayParams
-from colregs9_cli.replay_results import ENCOUNTER_COLUMNS, PAIR_COLUMNS
-from colregs9_cli.simulate import simulate_scenario
 
 from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, NMEA, SCENARIOS
 from seat_checks import assert_seats_agree

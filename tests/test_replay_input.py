@@ -11,11 +11,11 @@ import pandas as pd
 import pytest
 from test_replay_cli import write_dma
 
-from colregs9_cli.ais.dataset import ingest
 from colregs9_cli.ais.load import load_ais
+from colregs9_cli.jobs.ingest import ingest
+from colregs9_cli.jobs.replay import REPLAY_COLUMNS, run_replay
+from colregs9_cli.jobs.replay_input import open_replay_input
 from colregs9_cli.query import everything_query, load_query
-from colregs9_cli.replay import REPLAY_COLUMNS, run_replay
-from colregs9_cli.replay_input import open_replay_input
 
 from fixture_files import DMA22, DMA26, NMEA, ROOT
 
@@ -119,7 +119,7 @@ def test_the_slabs_are_read_from_the_dataset_one_window_at_a_time(
     nmea_dataset: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Memory holds one slab: every read is one slab's window, none the whole run."""
-    import colregs9_cli.replay_input as replay_input
+    import colregs9_cli.jobs.replay_input as replay_input
 
     windows: list[timedelta] = []
     read = replay_input.read_window_counted

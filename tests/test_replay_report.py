@@ -12,9 +12,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from colregs9_cli.chart import load_chart
-from colregs9_cli.replay import run_replay
-from colregs9_cli.replay_results import ENCOUNTER_COLUMNS, SERIES_COLUMNS
+from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.core.replay_results import ENCOUNTER_COLUMNS, SERIES_COLUMNS
+from colregs9_cli.jobs.replay import run_replay
+from colregs9_cli.jobs.simulate import simulate_scenario
 from colregs9_cli.report.chart_plot import DEPTH_LABEL, RESTRICTED_COLOUR
 from colregs9_cli.report.replay_report import (
     OUTLINES_PER_ARC,
@@ -22,7 +23,6 @@ from colregs9_cli.report.replay_report import (
     encounter_figure,
     trigger_positions_m,
 )
-from colregs9_cli.simulate import simulate_scenario
 from colregs9_cli.units import MPS_PER_KNOT
 
 from fixture_files import GREENHOPPER_QUERY, MODELLED_CHART, NMEA, ROOT

@@ -14,7 +14,7 @@ import pytest
 import shapely
 from matplotlib.text import Text
 
-from colregs9_cli.chart import load_chart
+from colregs9_cli.charts.chart import load_chart
 from colregs9_cli.report.chart_plot import NOT_CHARTED_LABEL
 from colregs9_cli.report.html_report import overview_figure, pair_numbers, place_labels
 from colregs9_cli.report.replay_report import DEFAULTED_NOTE, encounter_figure

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import pytest
 
-from colregs9_cli.colregs import Role, Situation
-from colregs9_cli.manoeuvrability import Restriction
-from colregs9_cli.replay import rests_on_defaults
-from colregs9_cli.rule9 import DecidingRule, decide_pair
-from colregs9_cli.vessel_defaults import VesselDimensions
+from colregs9_cli.core.colregs import Role, Situation
+from colregs9_cli.core.manoeuvrability import Restriction
+from colregs9_cli.core.rule9 import DecidingRule, decide_pair
+from colregs9_cli.core.vessel_defaults import VesselDimensions
+from colregs9_cli.jobs.replay import rests_on_defaults
 
 KNOWN = VesselDimensions(50.0, 9.0, 5.0, defaulted=(), basis="")
 DEFAULTED = VesselDimensions(12.0, 4.0, 1.5, defaulted=("draught_m",), basis="Class B")

@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from colregs9_cli.colregs import Role, Situation
-from colregs9_cli.rule9 import (
+from colregs9_cli.core.colregs import Role, Situation
+from colregs9_cli.core.rule9 import (
     INITIAL_STATE,
     MARKED_STATES,
     TRANSITIONS,

@@ -141,7 +141,7 @@ def test_report_geopackage_domains_are_typed_and_every_layer_is_styled(sandiego)
 def test_a_chart_far_from_the_ais_is_left_out_and_changes_nothing(
     sandiego, tmp_path_factory: pytest.TempPathFactory
 ) -> None:
-    from colregs9_cli.replay import run_replay
+    from colregs9_cli.jobs.replay import run_replay
 
     from fixture_files import ROOT, SANDIEGO_ENC
 

@@ -12,12 +12,12 @@ import pytest
 from shapely.geometry import Point
 from typer.testing import CliRunner
 
-from colregs9_cli.chart import load_chart
+from colregs9_cli.charts.chart import load_chart
 from colregs9_cli.cli import app
 from colregs9_cli.errors import QueryError
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.scenario import VesselRole, check_scenario_chart, load_scenario
-from colregs9_cli.simulate import simulate
+from colregs9_cli.jobs.scenario import VesselRole, check_scenario_chart, load_scenario
+from colregs9_cli.jobs.simulate import simulate
 from colregs9_cli.units import knots_to_mps
 
 from fixture_files import MODELLED_CHART, SCENARIOS

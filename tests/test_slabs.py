@@ -12,14 +12,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_replay_cli import write_dma
 
-from colregs9_cli.replay import run_replay
-from colregs9_cli.replay_params import ReplayParams
-from colregs9_cli.tracks import (
+from colregs9_cli.core.replay_params import ReplayParams
+from colregs9_cli.core.tracks import (
     NO_TRACK_STATS,
     REPORT_COLUMNS,
     empty_carry,
     segment_reports,
 )
+from colregs9_cli.jobs.replay import run_replay
 
 from fixture_files import NMEA, SANDIEGO_AIS, SANDIEGO_ENC
 

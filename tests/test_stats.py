@@ -13,7 +13,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from matplotlib.patches import Rectangle
 
-from colregs9_cli.dimensions import (
+from colregs9_cli.core.dimensions import (
     GroupBy,
     Per,
     dimension_stats,

@@ -22,9 +22,9 @@ from pyais.stream import IterMessages
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
-from colregs9_cli.dimensions import GroupBy, Per
+from colregs9_cli.core.dimensions import GroupBy, Per
+from colregs9_cli.jobs.stats import run_stats
 from colregs9_cli.report.stats_report import histogram_figure
-from colregs9_cli.stats import run_stats
 
 from fixture_files import DMA22, DMA26, MARINECADASTRE, NMEA, ROOT
 

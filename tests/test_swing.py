@@ -15,10 +15,10 @@ import pandas as pd
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
-from colregs9_cli.manoeuvrability import reference_vessels
-from colregs9_cli.report.atomic import is_report
+from colregs9_cli.core.manoeuvrability import reference_vessels
+from colregs9_cli.jobs.swing import run_swing
+from colregs9_cli.outputs import is_report
 from colregs9_cli.report.swing_plot import rate_of_swing_figure
-from colregs9_cli.swing import run_swing
 
 
 def test_run_swing_writes_the_table(tmp_path: Path) -> None:

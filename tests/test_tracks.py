@@ -13,9 +13,9 @@ from pyproj import Geod
 
 from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
+from colregs9_cli.core.replay_params import CourseSource, ReplayParams
+from colregs9_cli.core.tracks import SAMPLE_COLUMNS, TrackStats, build_tracks
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.replay_params import CourseSource, ReplayParams
-from colregs9_cli.tracks import SAMPLE_COLUMNS, TrackStats, build_tracks
 from colregs9_cli.units import MPS_PER_KNOT
 
 FRAME = LocalFrame(57.05, 9.94)

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from colregs9_cli.replay_params import ReplayParams
-from colregs9_cli.vessel_defaults import DIMENSIONS, default_table, vessel_dimensions
+from colregs9_cli.core.replay_params import ReplayParams
+from colregs9_cli.core.vessel_defaults import DIMENSIONS, default_table, vessel_dimensions
 
 
 def test_reported_dimensions_are_kept() -> None:

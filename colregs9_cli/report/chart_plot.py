@@ -28,9 +28,9 @@ from matplotlib.ticker import FuncFormatter, MaxNLocator
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
 if TYPE_CHECKING:
-    from ..chart import Chart
+    from ..charts.chart import Chart
+    from ..core.manoeuvrability import ManoeuvrabilityAssessment
     from ..geo import LocalFrame
-    from ..manoeuvrability import ManoeuvrabilityAssessment
 
 LAND_COLOUR = "#d9c7a0"
 WATER_EDGE_COLOUR = "#00c853"

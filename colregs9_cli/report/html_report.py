@@ -18,12 +18,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..replay_results import EncounterOutcome, ReplayResult
+from ..core.replay_results import EncounterOutcome, ReplayResult
 from .chart_plot import Bounds, draw_chart, geographic_axes, show_view
 from .html_page import cell_text, file_links, page, sortable_table
 
 if TYPE_CHECKING:
-    from ..chart import Chart
+    from ..charts.chart import Chart
 
 ENCOUNTER_TABLE_COLUMNS = (
     "encounter",

@@ -36,10 +36,10 @@ import pandas as pd
 import pyogrio
 import shapely
 
-from ..chart import Chart
+from ..charts.chart import Chart
+from ..core.replay_results import EncounterOutcome, EncounterSummary, ReplayResult
 from ..geo import LocalFrame
-from ..replay_results import EncounterOutcome, EncounterSummary, ReplayResult
-from .atomic import atomic_path
+from ..outputs import atomic_path
 from .qgis_styles import add_layer_styles
 
 GEOPACKAGE_NAME = "report.gpkg"

@@ -2,7 +2,7 @@
 encounter (per seat), index.md and run.json.
 
 Every file is written atomically. The verdicts and time series come from
-``colregs9_cli.replay``; this module only lays them out and draws them.
+``colregs9_cli.jobs.replay``; this module only lays them out and draws them.
 """
 
 from __future__ import annotations
@@ -26,14 +26,14 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from ..replay_results import (
+from ..core.replay_results import (
     ENCOUNTER_COLUMNS,
     PAIR_COLUMNS,
     EncounterOutcome,
     PairOutcome,
     ReplayResult,
 )
-from .atomic import report_directory, save_figure, write_csv, write_json, write_text
+from ..outputs import report_directory, save_figure, write_csv, write_json, write_text
 from .chart_plot import (
     DEPTH_LABEL,
     NOT_CHARTED_LABEL,
@@ -49,7 +49,7 @@ from .html_report import replay_html
 from .replay_geopackage import GEOPACKAGE_NAME, encounter_layers, write_replay_geopackage
 
 if TYPE_CHECKING:
-    from ..chart import Chart
+    from ..charts.chart import Chart
     from ..geo import LocalFrame
     from ..progress import ProgressSink
 

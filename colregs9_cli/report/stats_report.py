@@ -1,7 +1,7 @@
 """The reports of ``colregs9 stats``: CSV, Markdown (the paper's table), histograms, run.json.
 
-Every file is written atomically. The statistics themselves come from ``colregs9_cli.dimensions``;
-this module only lays them out.
+Every file is written atomically. The statistics themselves come from ``core.dimensions``; this
+module only lays them out.
 """
 
 from __future__ import annotations
@@ -17,13 +17,13 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
-from .atomic import report_directory, save_figure, write_csv, write_json, write_text
+from ..outputs import report_directory, save_figure, write_csv, write_json, write_text
+from ..provenance import inputs_manifest, query_manifest, run_header
 from .html_page import HTML_NAME, stats_html
-from .manifest import inputs_manifest, query_manifest, run_header
 
 if TYPE_CHECKING:
     from ..ais.load import CountedAis
-    from ..dimensions import StatsResult, StatsTable
+    from ..core.dimensions import StatsResult, StatsTable
     from ..query import Query
 
 CSV_NAME = "dimension_stats.csv"

@@ -37,8 +37,8 @@ import shapely
 from numpy.typing import NDArray
 from shapely.ops import polylabel
 
-from colregs9_cli.chart import Chart, load_chart
-from colregs9_cli.manoeuvrability import (
+from colregs9_cli.charts.chart import Chart, load_chart
+from colregs9_cli.core.manoeuvrability import (
     ManoeuvrabilityParams,
     assess_manoeuvrability,
     target_rate_of_swing_deg_per_m,

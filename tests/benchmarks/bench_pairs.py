@@ -24,10 +24,10 @@ import time
 import numpy as np
 import pandas as pd
 
-from colregs9_cli.encounters import find_encounters
+from colregs9_cli.core.encounters import find_encounters
+from colregs9_cli.core.replay_params import ReplayParams
+from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.replay_params import ReplayParams
-from colregs9_cli.tracks import build_tracks
 from colregs9_cli.units import MPS_PER_KNOT
 
 FRAME = LocalFrame(57.05, 9.94)

@@ -24,12 +24,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from colregs9_cli.encounters import find_encounters
+from colregs9_cli.core.encounters import find_encounters
+from colregs9_cli.core.replay_params import ReplayParams
+from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.replay import run_replay
-from colregs9_cli.replay_params import ReplayParams
-from colregs9_cli.simulate import DMA_COLUMNS
-from colregs9_cli.tracks import build_tracks
+from colregs9_cli.jobs.replay import run_replay
+from colregs9_cli.jobs.simulate import DMA_COLUMNS
 from colregs9_cli.units import MPS_PER_KNOT
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -28,7 +28,7 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .units import signed_angle_deg
+from ..units import signed_angle_deg
 
 
 class Fact(StrEnum):

@@ -62,8 +62,8 @@ from pyogrio.errors import DataLayerError, DataSourceError, FieldError, Geometry
 from pyproj import CRS, Transformer
 from pyproj.exceptions import CRSError
 
-from .errors import ChartError, ParameterError
-from .geo import FRAME_REACH_M, LocalFrame
+from ..errors import ChartError, ParameterError
+from ..geo import FRAME_REACH_M, LocalFrame
 from .s57_records import record_count
 from .s57_updates import applied_updates, update_files_beside
 

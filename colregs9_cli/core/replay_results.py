@@ -13,9 +13,9 @@ from typing import Any
 
 import pandas as pd
 
+from ..geo import LocalFrame
 from .audit import Action, Conduct, Fact
 from .colregs import ColregsParams, Role, Situation, SituationBasis
-from .geo import LocalFrame
 from .manoeuvrability import ManoeuvrabilityAssessment, ManoeuvrabilityParams, Restriction
 from .replay_params import ReplayParams
 from .rule9 import DecidingRule

@@ -42,13 +42,11 @@ import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 from numpy.typing import NDArray
 
-from .chart import Chart
-from .encounters import Encounter, find_encounters
-from .geo import LocalFrame
-from .progress import ProgressSink
-from .replay_params import CourseSource, ReplayParams
-from .replay_results import PairOutcome
-from .tracks import (
+from ..charts.chart import Chart
+from ..core.encounters import Encounter, find_encounters
+from ..core.replay_params import CourseSource, ReplayParams
+from ..core.replay_results import PairOutcome
+from ..core.tracks import (
     KEPT_COLUMNS,
     NO_TRACK_STATS,
     Tracks,
@@ -61,6 +59,8 @@ from .tracks import (
     segment_reports,
     vessel_statics,
 )
+from ..geo import LocalFrame
+from ..progress import ProgressSink
 
 # Sums of sines and cosines of longitudes in fixed point, so that the frame's centre does
 # not depend on the order in which slabs add them up.

@@ -25,10 +25,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .ais.schema import NAV_STATUS_CODES
-from .geo import LocalFrame
-from .progress import progress_bar, progress_enabled
-from .report.atomic import check_out_file, write_csv
+from ..ais.schema import NAV_STATUS_CODES
+from ..geo import LocalFrame
+from ..outputs import check_out_file, write_csv
+from ..progress import progress_bar, progress_enabled
+from ..units import knots_to_mps, wrap_deg
 from .scenario import (
     Scenario,
     VesselSpec,
@@ -36,7 +37,6 @@ from .scenario import (
     load_scenario,
     scenario_frame,
 )
-from .units import knots_to_mps, wrap_deg
 
 DMA_COLUMNS: tuple[str, ...] = (
     "# Timestamp",

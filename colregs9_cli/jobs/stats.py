@@ -1,5 +1,5 @@
 """``colregs9 stats``: read the AIS through a query, compute the dimension statistics
-(``colregs9_cli.dimensions``) and write the reports (``report/stats_report.py``).
+(``colregs9_cli.core.dimensions``) and write the reports (``report/stats_report.py``).
 
 The first input starts being read before pandas and matplotlib are imported: their import
 takes about half a second on one core, and the CSV parse takes the other meanwhile
@@ -15,11 +15,11 @@ from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from .ais.csv_read import start_reading
-from .errors import ParameterError
+from ..ais.csv_read import start_reading
+from ..errors import ParameterError
 
 if TYPE_CHECKING:
-    from .dimensions import GroupBy, Per, StatsResult
+    from ..core.dimensions import GroupBy, Per, StatsResult
 
 E = TypeVar("E", bound=StrEnum)
 
@@ -63,16 +63,16 @@ def run_stats(
     ``Colregs9Error`` subclasses for bad input files, queries or options.
     """
     with start_reading(paths, fmt) as started:
-        from .query import everything_query, load_query
+        from ..query import everything_query, load_query
 
         query = load_query(query_path) if query_path is not None else everything_query()
-        from .report.atomic import check_out_dir
+        from ..outputs import check_out_dir
 
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
         check_out_dir(target, overwrite, inputs=[*paths, *([query_path] if query_path else [])])
-        from .ais.load import count_ais
-        from .dimensions import GroupBy, Per, dimension_stats
-        from .report.stats_report import build_manifest, format_text, write_stats_reports
+        from ..ais.load import count_ais
+        from ..core.dimensions import GroupBy, Per, dimension_stats
+        from ..report.stats_report import build_manifest, format_text, write_stats_reports
 
         per = _choice(Per, per, "--per")
         by = None if by is None else _choice(GroupBy, by, "--by")

@@ -36,14 +36,14 @@ import numpy as np
 import pandas as pd
 import pyarrow.compute as pc
 
-from .ais.dataset import ingest_with_query, read_window_counted
-from .ais.dataset_scan import Dataset, is_dataset, position_filter
-from .ais.ledger import RejectReason, RejectsLedger
-from .ais.load import InputFile, canonical_frame, load_ais, no_positions_error
-from .errors import InputFileError
-from .progress import ProgressSink
-from .query import Query
-from .replay_params import ReplayParams
+from ..ais.dataset_scan import Dataset, is_dataset, position_filter
+from ..ais.ledger import RejectReason, RejectsLedger
+from ..ais.load import InputFile, canonical_frame, load_ais, no_positions_error
+from ..core.replay_params import ReplayParams
+from ..errors import InputFileError
+from ..progress import ProgressSink
+from ..query import Query
+from .ingest import ingest_with_query, read_window_counted
 from .slabs import Segmentation, SegmentedPart, merge_parts, segment_part, slab_of, slabs_of_frame
 
 __all__ = [

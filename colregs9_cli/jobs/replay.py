@@ -45,9 +45,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .ais.ledger import RejectReason, RejectsLedger
-from .ais.load import InputFile
-from .audit import (
+from ..ais.ledger import RejectReason, RejectsLedger
+from ..ais.load import InputFile
+from ..charts.chart import Chart, ChartSource, project_charts, read_charts
+from ..core.audit import (
     INSUFFICIENT_CONDUCT,
     Conduct,
     ConductParams,
@@ -56,29 +57,23 @@ from .audit import (
     negated,
     passage,
 )
-from .chart import Chart, ChartSource, project_charts, read_charts
-from .colregs import (
+from ..core.colregs import (
     ColregsEvaluation,
     Kinematics,
     Role,
     colregs_params_from_table,
     evaluate_colregs,
 )
-from .encounters import Encounter, encounter_series, velocity_mps
-from .errors import ChartError, NoDataError, ParameterError
-from .geo import LocalFrame, sail
-from .manoeuvrability import (
+from ..core.encounters import Encounter, encounter_series, velocity_mps
+from ..core.manoeuvrability import (
     ManoeuvrabilityAssessment,
     ManoeuvrabilityParams,
     Restriction,
     assess_manoeuvrability,
     unplaced_assessment,
 )
-from .progress import progress_bar, progress_enabled
-from .query import Query, everything_query, load_query
-from .replay_input import open_replay_input, segment_input_part
-from .replay_params import ReplayParams, replay_params_from_table
-from .replay_results import (
+from ..core.replay_params import ReplayParams, replay_params_from_table
+from ..core.replay_results import (
     SERIES_COLUMNS,
     SERIES_VESSEL_FIELDS,
     EncounterOutcome,
@@ -90,10 +85,17 @@ from .replay_results import (
     ReplayRunParams,
     VesselAtTrigger,
 )
-from .report.atomic import check_out_dir
-from .report.manifest import charts_manifest, inputs_manifest, jsonable, query_manifest, run_header
-from .report.replay_report import format_summary, write_replay_reports
-from .rule9 import Finding, PairVerdict, decide_pair, nav_status_finding
+from ..core.rule9 import Finding, PairVerdict, decide_pair, nav_status_finding
+from ..core.tracks import REQUIRED_COLUMNS, STATIC_COLUMNS, Tracks, TrackStats, context_s
+from ..core.vessel_defaults import VesselDimensions, vessel_dimensions
+from ..errors import ChartError, NoDataError, ParameterError
+from ..geo import LocalFrame, sail
+from ..outputs import check_out_dir
+from ..progress import progress_bar, progress_enabled
+from ..provenance import charts_manifest, inputs_manifest, jsonable, query_manifest, run_header
+from ..query import Query, everything_query, load_query
+from ..report.replay_report import format_summary, write_replay_reports
+from .replay_input import open_replay_input, segment_input_part
 from .slabs import (
     Extent,
     Segmentation,
@@ -101,8 +103,6 @@ from .slabs import (
     SlabResult,
     run_slabs,
 )
-from .tracks import REQUIRED_COLUMNS, STATIC_COLUMNS, Tracks, TrackStats, context_s
-from .vessel_defaults import VesselDimensions, vessel_dimensions
 
 # The canonical columns a replay reads: those of the reports and the static data.
 REPLAY_COLUMNS: tuple[str, ...] = (*REQUIRED_COLUMNS, *STATIC_COLUMNS)

@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
-from .. import __version__
-from ..s57_updates import applied_updates, update_files_beside
+from . import __version__
+from .charts.s57_updates import applied_updates, update_files_beside
 
 if TYPE_CHECKING:
-    from ..ais.load import InputFile
-    from ..query import Query
+    from .ais.load import InputFile
+    from .query import Query
 
 
 def jsonable(value: Any) -> Any:

@@ -1,7 +1,7 @@
 """Vessel dimension statistics (the paper's Table "Statistical overview of vessel dimensions").
 
 The computation (``dimension_stats``) is pure: it takes the positions selected by a query and
-the dimension reports of the whole input, and returns typed tables. ``colregs9_cli.stats``
+the dimension reports of the whole input, and returns typed tables. ``colregs9_cli.jobs.stats``
 runs it behind ``colregs9 stats``: read, compute, write the reports.
 
 Per vessel, a vessel's value is the median of all its valid reports in the input, each
@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .ais.schema import DIMENSIONS
+from ..ais.schema import DIMENSIONS
 
 STAT_COLUMNS: tuple[str, ...] = ("count", "mean", "median", "std", "min", "max")
 # Vessels whose ship type is never reported are grouped under this label with ``--by``.

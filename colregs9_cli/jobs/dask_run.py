@@ -27,13 +27,13 @@ import dask
 import pyarrow as pa
 from distributed import Client, Future, LocalCluster, as_completed
 
-from .chart import Chart
-from .errors import ParameterError
-from .geo import LocalFrame
-from .progress import ProgressSink
-from .quick_exit import fewer_collections
-from .replay_results import EncounterOutcome, seats_in_order
-from .report.replay_report import Drawer, draw_encounter
+from ..charts.chart import Chart
+from ..core.replay_results import EncounterOutcome, seats_in_order
+from ..errors import ParameterError
+from ..geo import LocalFrame
+from ..progress import ProgressSink
+from ..quick_exit import fewer_collections
+from ..report.replay_report import Drawer, draw_encounter
 from .slabs import PairEvaluator, SlabContext, SlabResult, replay_slab, slab_label
 
 Part = TypeVar("Part")

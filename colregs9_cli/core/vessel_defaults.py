@@ -20,8 +20,8 @@ from typing import Any
 
 import pandas as pd
 
-from .ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
-from .ais.schema import DIMENSIONS
+from ..ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
+from ..ais.schema import DIMENSIONS
 
 ANY = "*"
 

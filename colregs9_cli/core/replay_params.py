@@ -14,9 +14,9 @@ from dataclasses import dataclass, fields
 from enum import StrEnum
 from typing import Any
 
-from .config import dataclass_from_table
-from .errors import ParameterError
-from .units import METRES_PER_NAUTICAL_MILE
+from ..config import dataclass_from_table
+from ..errors import ParameterError
+from ..units import METRES_PER_NAUTICAL_MILE
 
 
 class CourseSource(StrEnum):

@@ -47,12 +47,12 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-from .config import dataclass_from_table
+from ..config import dataclass_from_table
+from ..errors import ParameterError
+from ..geo import course_in_tangent_plane
+from ..units import MPS_PER_KNOT, wrap_deg
 from .encounters import velocity_mps
-from .errors import ParameterError
-from .geo import course_in_tangent_plane
 from .replay_params import CourseSource
-from .units import MPS_PER_KNOT, wrap_deg
 
 
 class Situation(StrEnum):

@@ -40,11 +40,11 @@ import pandas as pd
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
-from .config import dataclass_from_table
-from .errors import ParameterError
+from ..config import dataclass_from_table
+from ..errors import ParameterError
 
 if TYPE_CHECKING:
-    from .chart import Chart, WaterIndex
+    from ..charts.chart import Chart, WaterIndex
 
 ELLIPSE_VERTICES = 32
 # Consecutive projected positions tested together by the coarse distance filter.

@@ -47,9 +47,9 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-from .geo import LocalFrame, ecef_m, normal_to_lat_lon, surface_normal, true_bearing_deg
+from ..geo import LocalFrame, ecef_m, normal_to_lat_lon, surface_normal, true_bearing_deg
+from ..units import MPS_PER_KNOT, signed_angle_deg, wrap_deg
 from .replay_params import CourseSource, ReplayParams
-from .units import MPS_PER_KNOT, signed_angle_deg, wrap_deg
 
 REQUIRED_COLUMNS: tuple[str, ...] = (
     "timestamp",

@@ -56,12 +56,7 @@ import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 
 from .. import __version__
-from ..errors import InputFileError, NoDataError, OutputError, ParameterError
-from ..progress import ProgressSink, progress_bar, progress_enabled
-from ..query import Query, everything_query, load_query
-from ..report.atomic import write_json
-from ..report.manifest import query_manifest
-from .dataset_scan import (
+from ..ais.dataset_scan import (
     DATASET_FORMAT,
     FORMAT_VERSION,
     MANIFEST_NAME,
@@ -77,17 +72,22 @@ from .dataset_scan import (
     scan_columns,
     utc_ms,
 )
-from .duplicates import ROW_ORDER, repeated_rows
-from .ledger import RejectReason, RejectsLedger
-from .load import (
+from ..ais.duplicates import ROW_ORDER, repeated_rows
+from ..ais.ledger import RejectReason, RejectsLedger
+from ..ais.load import (
     InputFile,
     check_format,
     ingest_params,
     no_positions_error,
     stream_ais,
 )
-from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
-from .sources import Source, inspect_source, sha256_file
+from ..ais.schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
+from ..ais.sources import Source, inspect_source, sha256_file
+from ..errors import InputFileError, NoDataError, OutputError, ParameterError
+from ..outputs import write_json
+from ..progress import ProgressSink, progress_bar, progress_enabled
+from ..provenance import query_manifest
+from ..query import Query, everything_query, load_query
 
 __all__ = [
     "IngestResult",

@@ -17,7 +17,7 @@ from typing import IO, Any
 
 import pandas as pd
 
-from ..errors import OutputError
+from .errors import OutputError
 
 
 def _kind(path: Path) -> str:

@@ -28,12 +28,12 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
-from .errors import InputFileError, NoDataError
+from ..core.replay_results import EncounterOutcome, ReplayResult
+from ..errors import InputFileError, NoDataError
+from ..outputs import REPORT_MARKER, check_out_dir, report_directory, write_json
+from ..provenance import charts_manifest, run_header
+from ..report.replay_report import ENCOUNTER_DIR
 from .replay import run_replay
-from .replay_results import EncounterOutcome, ReplayResult
-from .report.atomic import REPORT_MARKER, check_out_dir, report_directory, write_json
-from .report.manifest import charts_manifest, run_header
-from .report.replay_report import ENCOUNTER_DIR
 from .simulate import SimulationResult, simulate_scenario
 
 SCENARIO_NAMES: tuple[str, ...] = ("greenhopper_restricted", "greenhopper_not_restricted")

@@ -29,8 +29,8 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import NoDataError
-from .geo import ecef_m, in_tangent_plane, velocity_ecef_mps
+from ..errors import NoDataError
+from ..geo import ecef_m, in_tangent_plane, velocity_ecef_mps
 from .replay_params import ReplayParams
 from .tracks import STATE_COLUMNS, Tracks
 

@@ -8,8 +8,8 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import pandas as pd
 
-from .manoeuvrability import ManoeuvrabilityParams, reference_vessels
-from .report.atomic import (
+from ..core.manoeuvrability import ManoeuvrabilityParams, reference_vessels
+from ..outputs import (
     REPORT_MARKER,
     check_out_dir,
     report_directory,
@@ -17,8 +17,8 @@ from .report.atomic import (
     write_csv,
     write_json,
 )
-from .report.manifest import run_header
-from .report.swing_plot import rate_of_swing_figure
+from ..provenance import run_header
+from ..report.swing_plot import rate_of_swing_figure
 
 DEFAULT_OUT_DIR = Path("reports/swing")
 CSV_NAME = "rate_of_swing.csv"

@@ -23,12 +23,12 @@ from typing import Any
 import numpy as np
 from shapely.geometry import LineString, Point
 
-from .ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M, MMSI_MAX, MMSI_MIN
-from .chart import Chart, load_chart
-from .config import read_toml
-from .errors import QueryError
-from .geo import LocalFrame
-from .query import is_report_name
+from ..ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M, MMSI_MAX, MMSI_MIN
+from ..charts.chart import Chart, load_chart
+from ..config import read_toml
+from ..errors import QueryError
+from ..geo import LocalFrame
+from ..query import is_report_name
 
 _SCENARIO_KEYS = {
     "name": str,

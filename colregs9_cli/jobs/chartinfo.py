@@ -17,11 +17,11 @@ import numpy as np
 import pyogrio
 import shapely
 
-from .chart import CellInfo, Chart, load_chart
-from .errors import OutputError, ParameterError
-from .progress import progress_bar, progress_enabled
-from .report.atomic import atomic_path, check_out_file, save_figure
-from .report.chart_plot import draw_chart, geographic_axes
+from ..charts.chart import CellInfo, Chart, load_chart
+from ..errors import OutputError, ParameterError
+from ..outputs import atomic_path, check_out_file, save_figure
+from ..progress import progress_bar, progress_enabled
+from ..report.chart_plot import draw_chart, geographic_axes
 
 DEFAULT_REPORTS_DIR = Path("reports")
 GEOPACKAGE_LAYERS = ("depth_areas", "coverage", "land", "navigable_water")
