@@ -14,8 +14,8 @@ import typer
 from typer.core import TyperCommand, TyperGroup
 
 from . import __version__
+from .ais.layouts import LAYOUTS
 from .errors import Colregs9Error, OutputError
-from .quick_exit import run_and_exit
 
 # --quiet means the same everywhere: stdout carries the results, stderr the progress and the
 # closing line that says where the files went; --quiet silences stderr but for errors.
@@ -31,16 +31,16 @@ AIS_FILES_HELP = (
     "xz, zstd, or a zip holding one file)"
 )
 DATASETS_HELP = "; or dataset directories made by colregs9 ingest."
-# The values of ais.detect.LAYOUTS, written out: importing it would load pyarrow for --help.
+# The layouts' names, from their registry (a light module: --help does not load pyarrow).
 LAYOUT_HELP = (
-    "Input layout instead of detecting it: dma26, dma22, marinecadastre, marinecadastre2015, "
-    "marinecadastre2025, exactearth, nmea, parquet. Needed for a CSV without its header."
+    f"Input layout instead of detecting it: {', '.join(LAYOUTS)}. "
+    "Needed for a CSV without its header."
 )
 COLUMNS_HELP = (
     "Column map (TOML) for any other CSV: source column -> canonical column, time format, "
     "units, sentinels (README: Column maps)."
 )
-# What chart.py reads, told by the suffix.
+# What charts/read.py reads, told by the suffix.
 CHART_FORMATS = (
     "S-57 base cell .000 (with its updates .001, .002 … beside it), GeoJSON (.geojson, .json) "
     "or GeoPackage (.gpkg)"
@@ -694,5 +694,11 @@ def demo_command(
 
 
 def run() -> None:
-    """The ``colregs9`` console script: the app, then a quick exit (see ``quick_exit``)."""
+    """The ``colregs9`` console script: the app, then a quick exit (see ``quick_exit``).
+
+    Only here: the SIGTERM handler, the collector's thresholds and ``os._exit`` are the
+    console script's. ``app`` itself (``CliRunner``, an embedding program) and the library
+    leave the process as they find it."""
+    from .quick_exit import run_and_exit
+
     run_and_exit(app)

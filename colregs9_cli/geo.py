@@ -140,8 +140,8 @@ class LocalFrame:
 
         Within ``_SERIES_REACH_DEG`` of the central meridian γ comes from its series in the
         longitude difference (Redfearn's, to the fifth power): within 1.6e-5° of PROJ there,
-        at any latitude, and eight times faster than PROJ's ``get_factors``, which computes
-        twelve factors to give this one. Farther out PROJ computes it.
+        at any latitude, and faster than PROJ's ``get_factors``, which computes twelve factors
+        to give this one (figures: tests/benchmarks/README.md). Farther out PROJ computes it.
         """
         lat, lon = np.broadcast_arrays(
             np.asarray(lat_deg, dtype=float), np.asarray(lon_deg, dtype=float)
@@ -262,6 +262,23 @@ def velocity_ecef_mps(
     north_mps = np.where(at_rest, 0.0, speed * np.cos(course))
     east_mps = np.where(at_rest, 0.0, speed * np.sin(course))
     return north_mps[..., None] * north + east_mps[..., None] * east
+
+
+def velocity_mps(
+    speed_mps: ArrayLike, course_deg: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(north, east) velocity components of a speed along a course.
+
+    The components are along the axes the course is measured from: give a grid course
+    (``cog_grid_deg``) for a velocity in the ``LocalFrame``.
+    """
+    course_rad = np.radians(np.asarray(course_deg, dtype=float))
+    speed = np.asarray(speed_mps, dtype=float)
+    at_rest = speed == 0.0  # no velocity whatever her course, known or not (velocity_ecef_mps)
+    return (
+        np.where(at_rest, 0.0, speed * np.cos(course_rad)),
+        np.where(at_rest, 0.0, speed * np.sin(course_rad)),
+    )
 
 
 def in_tangent_plane(

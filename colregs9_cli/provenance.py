@@ -1,4 +1,6 @@
-"""The parts every run.json shares: tool and version, the query, the inputs, JSON values."""
+"""The parts every run.json shares: tool and version, the query, the inputs, JSON values.
+
+Each chart's files and hashes are ``charts.provenance.charts_manifest``."""
 
 from __future__ import annotations
 
@@ -10,16 +12,31 @@ from collections.abc import Mapping, Sequence
 from datetime import UTC, datetime
 from enum import Enum
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import pandas as pd
 
 from . import __version__
-from .charts.s57_updates import applied_updates, update_files_beside
 
 if TYPE_CHECKING:
-    from .ais.load import InputFile
     from .query import Query
+
+
+class InputRecord(Protocol):
+    """One input of a run as run.json records it (``ais.inputs.InputFile`` is one)."""
+
+    @property
+    def path(self) -> Path: ...
+    @property
+    def sha256(self) -> str: ...
+    @property
+    def layout(self) -> str: ...
+    @property
+    def rows_read(self) -> int: ...
+    @property
+    def dataset(self) -> Path | None: ...
+    @property
+    def ingest_query(self) -> Mapping[str, Any] | None: ...
 
 
 def jsonable(value: Any) -> Any:
@@ -59,34 +76,8 @@ def run_header(command: str) -> dict[str, Any]:
     }
 
 
-def charts_manifest(
-    paths: Sequence[Path], used: Sequence[Path] | None = None
-) -> list[dict[str, Any]]:
-    """Each chart given, with every file that went into it or lies beside it and its sha256:
-    an S-57 base cell ``X.000`` with the update files ``X.001``, ``X.002`` …, each marked
-    ``applied`` or not (GDAL applies none after a gap), and the names of those missing.
-    ``used``: the charts the run used (the others lie away from the AIS); default all."""
-    charts = []
-    for path in paths:
-        updates, missing = update_files_beside(path) if path.suffix == ".000" else ([], [])
-        applied = applied_updates(updates, missing)
-        files = [{"path": str(path), "sha256": _sha256(path), "applied": True}]
-        files += [
-            {"path": str(update), "sha256": _sha256(update), "applied": update in applied}
-            for update in updates
-        ]
-        charts.append(
-            {
-                "path": str(path),
-                "used": used is None or Path(path) in {Path(u) for u in used},
-                "files": files,
-                "missing_updates": missing,
-            }
-        )
-    return charts
-
-
-def _sha256(path: Path) -> str:
+def file_sha256(path: Path) -> str:
+    """The sha256 of a file's bytes, in hex."""
     with path.open("rb") as handle:
         return hashlib.file_digest(handle, "sha256").hexdigest()
 
@@ -102,7 +93,7 @@ def query_manifest(query: Query) -> dict[str, Any]:
     }
 
 
-def inputs_manifest(inputs: Sequence[InputFile]) -> list[dict[str, Any]]:
+def inputs_manifest(inputs: Sequence[InputRecord]) -> list[dict[str, Any]]:
     """Each input file; one read from a dataset (``colregs9 ingest``) names it too, with the
     query it was ingested through."""
     return [

@@ -37,9 +37,9 @@ from numpy.typing import ArrayLike, NDArray
 from shapely.geometry import MultiPolygon, Polygon, shape
 from shapely.geometry.base import BaseGeometry
 
-from .ais.schema import VESSEL_MOBILE_TYPES
 from .config import read_toml
 from .errors import InputFileError, QueryError
+from .vessels import NINE_DIGIT_MMSI_MAX, NINE_DIGIT_MMSI_MIN, VESSEL_MOBILE_TYPES
 
 if TYPE_CHECKING:
     from .geo import LocalFrame
@@ -65,7 +65,6 @@ VESSEL_KEYS = frozenset(
 )
 # Query names become directory names (reports/stats-<name>/).
 _NAME_PATTERN = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]*$")
-_MMSI_MIN, _MMSI_MAX = 100_000_000, 999_999_999
 
 
 def is_report_name(name: Any) -> bool:
@@ -209,7 +208,9 @@ class VesselFilter:
             bad_mmsi = [
                 v
                 for v in values
-                if isinstance(v, bool) or not isinstance(v, int) or not _MMSI_MIN <= v <= _MMSI_MAX
+                if isinstance(v, bool)
+                or not isinstance(v, int)
+                or not NINE_DIGIT_MMSI_MIN <= v <= NINE_DIGIT_MMSI_MAX
             ]
             if bad_mmsi:
                 raise QueryError(f"{key} contains {bad_mmsi[0]!r}; an MMSI is a 9-digit integer")

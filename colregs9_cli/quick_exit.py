@@ -2,10 +2,14 @@
 command is done without tearing the interpreter down.
 
 A normal exit finalises the interpreter: it frees every object of pandas, matplotlib and
-pyarrow one by one, which takes 0.15-0.2 s after every run, once all the work is done. The
-console script therefore flushes the standard streams and leaves with ``os._exit``, as mypy
-does by default (``mypy.util.hard_exit``). Nothing is lost: every command closes the files it
-writes (atomically) and joins its threads before it returns.
+pyarrow one by one, a noticeable wait after every run, once all the work is done. The console
+script therefore flushes the standard streams and leaves with ``os._exit``, as mypy does by
+default (``mypy.util.hard_exit``). Nothing is lost: every command closes the files it writes
+(atomically) and joins its threads before it returns.
+
+Only the console script's ``cli.run`` calls ``run_and_exit``: the Typer app, the library
+(``colregs9_cli.api``) and the jobs leave the process's exit, signal handlers and collector
+as they find them. ``fewer_collections`` changes the collector only within its block.
 """
 
 from __future__ import annotations
@@ -14,15 +18,17 @@ import gc
 import os
 import signal
 import sys
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import NoReturn
 
 # What CPython exits with when it cannot flush stdout at exit (e.g. a closed pipe).
 _UNFLUSHED_STATUS = 120
 # Allocations between two collections of the youngest generation (CPython's default: 700).
 # A command imports pandas, matplotlib and pyarrow: about a million objects that live until
-# the end, which the collector would walk again and again (0.12 s of the 0.96 s those
-# imports take; 0.08 s less with this threshold). Cycles are still collected, less often.
+# the end, which the collector would walk again and again, a sizeable share of the imports'
+# time (figures: tests/benchmarks/README.md). Cycles are still collected, less often.
 GC_YOUNG_THRESHOLD = 50_000
 
 
@@ -47,11 +53,34 @@ def flush_streams(status: int) -> int:
     return status
 
 
-def fewer_collections() -> None:
-    """Collect the youngest generation every ``GC_YOUNG_THRESHOLD`` allocations: in the
-    console script, and in the Dask workers of a replay, which hold the same objects."""
-    _, older, oldest = gc.get_threshold()
-    gc.set_threshold(GC_YOUNG_THRESHOLD, older, oldest)
+# The thresholds are the process's: blocks that overlap (tasks on the threads of one Dask
+# worker) share one change, made by the first to enter and undone by the last to leave,
+# whatever order they leave in. One entry per open block: the thresholds before the first.
+_blocks_lock = threading.Lock()
+_open_blocks: list[tuple[int, int, int]] = []
+
+
+@contextmanager
+def fewer_collections() -> Iterator[None]:
+    """Within the block, collect the youngest generation every ``GC_YOUNG_THRESHOLD``
+    allocations; on leaving it, the collector's thresholds are again what they were. Used by
+    the console script around its command, and by the Dask workers of a replay around each
+    task, which hold the same objects."""
+    with _blocks_lock:
+        if _open_blocks:
+            before = _open_blocks[0]
+        else:
+            before = gc.get_threshold()
+            _, older, oldest = before
+            gc.set_threshold(GC_YOUNG_THRESHOLD, older, oldest)
+        _open_blocks.append(before)
+    try:
+        yield
+    finally:
+        with _blocks_lock:
+            _open_blocks.pop()
+            if not _open_blocks:
+                gc.set_threshold(*before)
 
 
 # The status of a command stopped by SIGTERM: 128 + 15, as a shell reports it.
@@ -72,9 +101,9 @@ def run_and_exit(main: Callable[[], object]) -> NoReturn:
     does, so that it removes its staging and scratch directories on the way out, and it
     leaves with status 143."""
     signal.signal(signal.SIGTERM, _interrupt)
-    fewer_collections()
     try:
-        main()
+        with fewer_collections():
+            main()
         status = 0
     except SystemExit as exit_:
         status = exit_status(exit_)

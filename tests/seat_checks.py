@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import pandas as pd
 
+from colregs9_cli.core.rule9 import PairVerdict
+
 
 def _seat_pairs(table: pd.DataFrame) -> pd.DataFrame:
     """Each pair's two seats side by side (suffix _other for the mirrored seat)."""
@@ -58,3 +60,16 @@ def assert_seats_agree(table: pd.DataFrame) -> int:
         }
         assert named == by_role
     return len(pairs)
+
+
+def swapped(verdict: PairVerdict) -> PairVerdict:
+    """The same verdict with the vessels in the other order: what the other seat must get."""
+    return PairVerdict(
+        situation=verdict.situation,
+        role_colregs=(verdict.role_colregs[1], verdict.role_colregs[0]),
+        seat_a=verdict.seat_b,
+        seat_b=verdict.seat_a,
+        role_final=(verdict.role_final[1], verdict.role_final[0]),
+        deciding_rule=verdict.deciding_rule,
+        both_restricted=verdict.both_restricted,
+    )

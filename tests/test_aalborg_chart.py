@@ -180,7 +180,7 @@ def test_file_is_small_and_regenerates_identically(tmp_path: Path) -> None:
 
 
 def test_chart_loader_reads_the_modelled_chart() -> None:
-    from colregs9_cli.charts.chart import load_chart
+    from colregs9_cli.charts.water import load_chart
 
     chart = load_chart([MODELLED_CHART], FRAME)
     assert chart.depth_range_m() == (0.0, 8.0)

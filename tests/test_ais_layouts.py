@@ -15,13 +15,24 @@ import pandas as pd
 import pyarrow as pa
 import pytest
 
-from colregs9_cli.ais.column_map import load_column_map, map_layout
+from colregs9_cli.ais.column_map import BUILTIN_MAPS, load_column_map, map_layout
+from colregs9_cli.ais.detect import detect_layout
+from colregs9_cli.ais.dispatch import READERS
+from colregs9_cli.ais.layouts import (
+    DMA22_COLUMNS,
+    DMA26_COLUMNS,
+    DMA_COLUMNS,
+    LAYOUTS,
+    ReadAs,
+    find_layout,
+)
 from colregs9_cli.ais.load import load_ais
+from colregs9_cli.ais.sources import inspect_source, read_head
 from colregs9_cli.errors import InputFileError, ParameterError
 from colregs9_cli.jobs.ingest import ingest
 from colregs9_cli.jobs.stats import run_stats
 
-from fixture_files import AIS_FIXTURES, DMA26, MARINECADASTRE, NMEA, ROOT
+from fixture_files import AIS_FIXTURES, DMA22, DMA26, MARINECADASTRE, NMEA, ROOT
 
 MC2015 = AIS_FIXTURES / "marinecadastre2015_sample.csv"
 MC2025 = AIS_FIXTURES / "marinecadastre2025_sample.csv.zst"
@@ -468,3 +479,52 @@ def test_an_error_quoting_a_row_with_line_breaks_is_one_line(tmp_path: Path) -> 
         load_ais([path])
     message = str(caught.value)
     assert "\n" not in message and "a quote left open" in message and "\\n" in message
+
+
+# -- the registry of layouts (ais/layouts.py) ----------------------------------------------------
+
+
+@pytest.mark.parametrize("name", list(LAYOUTS))
+def test_each_layouts_example_is_detected_as_that_layout(tmp_path: Path, name: str) -> None:
+    """The registry's example of a layout's first line is told as that layout: the sniffs,
+    tried in their order, single out each one."""
+    layout = LAYOUTS[name]
+    path = tmp_path / "example"
+    path.write_bytes(layout.example.encode() + b"\n")
+    source = inspect_source(path)
+    assert detect_layout(source, read_head(source)) is layout
+
+
+def test_every_layout_has_a_reader_and_a_description() -> None:
+    assert set(READERS) == set(ReadAs)
+    for name, layout in LAYOUTS.items():
+        assert layout.name == name and layout.description and layout.example
+        assert layout.read_as.is_csv == bool(layout.header), name
+        assert (layout.read_as is ReadAs.DMA_CSV) == (layout.csv_columns is not None), name
+        assert (layout.read_as is ReadAs.MAPPED_CSV) == (name in BUILTIN_MAPS), name
+
+
+def test_dma_columns_are_those_of_the_dma_files() -> None:
+    """The reader's DMA names come from the header colregs9 writes, which is DMA's own."""
+    assert DMA26.read_text(encoding="utf-8").splitlines()[0] == ",".join(DMA_COLUMNS)
+    assert DMA22.read_text(encoding="utf-8").splitlines()[0] == ",".join(DMA_COLUMNS[:22])
+    assert DMA26_COLUMNS[:22] == DMA22_COLUMNS and DMA26_COLUMNS[22:] == ("a", "b", "c", "d")
+
+
+def test_find_layout_names_each_layout_or_refuses(tmp_path: Path) -> None:
+    assert all(find_layout(name) is layout for name, layout in LAYOUTS.items())
+    mapped = find_layout(map_layout(MAPS / "aishub.toml"))
+    assert mapped.read_as is ReadAs.MAPPED_CSV and mapped.map_file == MAPS / "aishub.toml"
+    with pytest.raises(ParameterError, match="use one of " + ", ".join(LAYOUTS)):
+        find_layout("aisdk")
+
+
+def test_the_dma_writer_writes_exactly_its_columns(tmp_path: Path) -> None:
+    writer = LAYOUTS["dma26"].csv_writer()
+    row = {column: "x" for column in reversed(DMA_COLUMNS)}
+    writer.write(tmp_path / "one.csv", pd.DataFrame([row]))
+    assert (tmp_path / "one.csv").read_text().splitlines()[0] == ",".join(DMA_COLUMNS)
+    with pytest.raises(ValueError, match="missing"):
+        writer.write(tmp_path / "two.csv", pd.DataFrame([row]).drop(columns="A"))
+    with pytest.raises(ValueError, match="colregs9 does not write"):
+        LAYOUTS["nmea"].csv_writer()

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from colregs9_cli.ais import csv_chunks, load
+from colregs9_cli.ais import csv_chunks, row_pipeline
 from colregs9_cli.ais.load import load_ais
 from colregs9_cli.errors import NoDataError
 from colregs9_cli.query import Query, Region, TimeWindow, VesselFilter, load_query
@@ -191,7 +191,7 @@ def test_small_chunks_and_batches_change_nothing_on_generated_dma(
     whole = load_ais([path], query=query)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(csv_chunks, "CHUNK_BYTES", chunk_bytes)
-        patch.setattr(load, "_SET_ASIDE_BYTES", 1)
+        patch.setattr(row_pipeline, "_SET_ASIDE_BYTES", 1)
         pieces = load_ais([path], query=query)
     pd.testing.assert_frame_equal(pieces.positions, whole.positions)
     pd.testing.assert_frame_equal(pieces.dimension_reports, whole.dimension_reports)

@@ -41,3 +41,77 @@ def test_no_two_modules_import_each_other() -> None:
         if b in modules and a in modules[b] and a < b
     )
     assert mutual == []
+
+
+# The layers of docs/design.md §3 and what each may not import. The package root's modules
+# (errors, config, geo, …) are the base every layer may use; the base imports no layer.
+LAYERS = ("ais", "charts", "core", "jobs", "report")
+FORBIDDEN: dict[str, frozenset[str]] = {
+    "base": frozenset(LAYERS),
+    "ais": frozenset({"core", "charts", "jobs", "report"}),
+    "charts": frozenset({"core", "jobs", "report", "ais"}),
+    "core": frozenset({"jobs", "report", "ais"}),
+    "report": frozenset({"jobs", "ais"}),
+    "jobs": frozenset(),
+}
+FACES = frozenset({"colregs9_cli.cli", "colregs9_cli.api", "colregs9_cli.__main__"})
+MAX_MODULE_LINES = 800
+MAX_FUNCTION_LINES = 120
+
+
+def _layer(module: str) -> str | None:
+    """The layer of a package module: ``ais`` … ``report``, ``base``, or None for the faces."""
+    if module in FACES:
+        return None
+    parts = module.split(".")
+    return parts[1] if len(parts) > 2 and parts[1] in LAYERS else "base"
+
+
+def _all_imports(path: Path) -> set[str]:
+    """Every package module ``path`` imports, at the top or inside a function or a
+    TYPE_CHECKING block (a lazy import still ties the layers together)."""
+    found = _imports(path)
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            found.update(a.name for a in node.names if a.name.startswith("colregs9_cli"))
+    return {name for name in found if name.startswith("colregs9_cli")}
+
+
+def test_imports_point_down_the_layers() -> None:
+    broken = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        module = _module_name(path)
+        layer = _layer(module)
+        if layer is None:
+            continue
+        for imported in sorted(_all_imports(path)):
+            target = _layer(imported)
+            if target in FORBIDDEN[layer]:
+                broken.append(f"{module} ({layer}) imports {imported} ({target})")
+    assert broken == []
+
+
+def test_the_contract_sees_a_forbidden_import() -> None:
+    """The check above can fail: a core module importing a job is found."""
+    assert _layer("colregs9_cli.core.pair") == "core"
+    assert _layer("colregs9_cli.jobs.replay") in FORBIDDEN["core"]
+    assert _layer("colregs9_cli.geo") == "base" and "core" in FORBIDDEN["base"]
+    assert _layer("colregs9_cli.cli") is None
+
+
+def test_no_module_or_function_is_too_long() -> None:
+    """Modules up to 800 lines, functions up to 120; the CLI's commands are mostly option
+    declarations, so only their bodies count."""
+    too_long = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        text = path.read_text(encoding="utf-8")
+        if text.count("\n") > MAX_MODULE_LINES:
+            too_long.append(f"{path.name}: {text.count(chr(10))} lines")
+        for node in ast.walk(ast.parse(text)):
+            if not isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                continue
+            start = node.body[0].lineno if path.name == "cli.py" else node.lineno
+            lines = (node.end_lineno or node.lineno) - start + 1
+            if lines > MAX_FUNCTION_LINES:
+                too_long.append(f"{path.name}:{node.lineno} {node.name}: {lines} lines")
+    assert too_long == []

@@ -157,7 +157,7 @@ def _implausible_marinecadastre(length: str, breadth: str, draught: str) -> bool
 def _implausible_canonical(length: str, breadth: str, draught: str) -> bool:
     """Parquet datasets and decoded NMEA: canonical float columns."""
     from colregs9_cli.ais.clean import DimensionColumns
-    from colregs9_cli.ais.load import _canonical_dimensions
+    from colregs9_cli.ais.dimension_reports import canonical_dimensions as _canonical_dimensions
 
     def number(text: str) -> float | None:
         return None if text == "" else float(text)

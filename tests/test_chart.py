@@ -7,18 +7,21 @@ import json
 import math
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 import shapely
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 from pyogrio.raw import read, write
 
-from colregs9_cli.charts.chart import HAZARD_RADIUS_M, Chart, load_chart, read_charts
-from colregs9_cli.core.manoeuvrability import ManoeuvrabilityParams, assess_manoeuvrability
+from colregs9_cli.charts.sources import read_charts
+from colregs9_cli.charts.water import HAZARD_RADIUS_M, Chart, load_chart
+from colregs9_cli.core.manoeuvrability import (
+    ManoeuvrabilityParams,
+    VesselState,
+    assess_manoeuvrability,
+)
+from colregs9_cli.core.vessel_defaults import VesselDimensions
 from colregs9_cli.errors import ChartError, ParameterError
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.report.chart_plot import draw_assessment, draw_chart
@@ -218,42 +221,41 @@ def test_missing_and_unknown_files(tmp_path: Path) -> None:
 
 
 def test_draw_chart_shades_depth_areas_by_drval1(enc: Chart) -> None:
-    figure, ax = plt.subplots()
-    try:
-        draw_chart(ax, enc, 5.0)
-        by_gid = {c.get_gid(): c for c in ax.collections}
-        assert set(by_gid) == {"depth-areas", "land", "navigable-water"}
-        np.testing.assert_array_equal(by_gid["depth-areas"].get_array(), enc.drval1_m)
-        assert len(by_gid["depth-areas"].get_paths()) == 249
-        # Outlined, not tinted, so the depth colours match the colour bar.
-        assert len(by_gid["navigable-water"].get_facecolor()) == 0
-        figure.canvas.draw()
-    finally:
-        plt.close(figure)
+    figure = Figure()
+    ax = figure.subplots()
+    draw_chart(ax, enc, 5.0)
+    by_gid = {c.get_gid(): c for c in ax.collections}
+    assert set(by_gid) == {"depth-areas", "land", "navigable-water"}
+    np.testing.assert_array_equal(by_gid["depth-areas"].get_array(), enc.drval1_m)
+    assert len(by_gid["depth-areas"].get_paths()) == 249
+    # Outlined, not tinted, so the depth colours match the colour bar.
+    assert len(by_gid["navigable-water"].get_facecolor()) == 0
+    FigureCanvasAgg(figure).draw()
 
 
 def test_draw_assessment_colours_ellipses_by_flag(enc: Chart) -> None:
     frame = LocalFrame(38.9625, -76.4625)
     assert enc.frame == frame
     assessment = assess_manoeuvrability(
-        enc, 3014.5, -1696.3, 145.0, 3.6, 50.0, 9.0, 5.0, ManoeuvrabilityParams()
+        enc,
+        VesselState(3014.5, -1696.3, 145.0, 3.6),
+        VesselDimensions(50.0, 9.0, 5.0, defaulted=(), basis=""),
+        ManoeuvrabilityParams(),
     )
-    figure, ax = plt.subplots()
-    try:
-        draw_assessment(ax, assessment)
-        by_gid = {c.get_gid(): c for c in ax.collections}
-        red = assessment.restricted & assessment.covered
-        assert len(by_gid["restricted-ellipses"].get_paths()) == red.sum() > 0
-        assert len(by_gid["clear-ellipses"].get_paths()) == (~red).sum() > 0
-        # The few restricted ellipses are not hidden under the clear ones.
-        assert by_gid["restricted-ellipses"].get_zorder() > by_gid["clear-ellipses"].get_zorder()
-        lines = {line.get_label(): line for line in ax.get_lines()}
-        np.testing.assert_allclose(
-            lines["cw arc"].get_xdata(), assessment.east_m[assessment.arc == "cw"]
-        )
-        figure.canvas.draw()
-    finally:
-        plt.close(figure)
+    figure = Figure()
+    ax = figure.subplots()
+    draw_assessment(ax, assessment)
+    by_gid = {c.get_gid(): c for c in ax.collections}
+    red = assessment.restricted & assessment.covered
+    assert len(by_gid["restricted-ellipses"].get_paths()) == red.sum() > 0
+    assert len(by_gid["clear-ellipses"].get_paths()) == (~red).sum() > 0
+    # The few restricted ellipses are not hidden under the clear ones.
+    assert by_gid["restricted-ellipses"].get_zorder() > by_gid["clear-ellipses"].get_zorder()
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    np.testing.assert_allclose(
+        lines["cw arc"].get_xdata(), assessment.east_m[assessment.arc == "cw"]
+    )
+    FigureCanvasAgg(figure).draw()
 
 
 def _two_squares(tmp_path: Path, gap_m: float) -> Chart:

@@ -12,8 +12,10 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from colregs9_cli.charts.chart import project_charts, read_charts, s57_cell_info
+from colregs9_cli.charts.cells import s57_cell_info
 from colregs9_cli.charts.s57_records import record_count
+from colregs9_cli.charts.sources import read_charts
+from colregs9_cli.charts.water import project_charts
 from colregs9_cli.cli import app
 from colregs9_cli.errors import ChartError
 from colregs9_cli.jobs.replay import run_replay

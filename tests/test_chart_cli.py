@@ -5,13 +5,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from matplotlib.figure import Figure
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
@@ -148,27 +144,25 @@ def test_an_out_under_a_file_is_refused(tmp_path: Path) -> None:
 
 
 def test_the_chart_plot_outlines_the_coverage(tmp_path: Path) -> None:
-    from colregs9_cli.charts.chart import load_chart
+    from colregs9_cli.charts.water import load_chart
     from colregs9_cli.report.chart_plot import draw_chart
 
     chart = load_chart([ENC])
-    figure, ax = plt.subplots()
-    try:
-        draw_chart(ax, chart, 5.0, coverage=True)
-        (edge,) = [c for c in ax.collections if c.get_gid() == "coverage"]
-        assert edge.get_label().startswith("chart edge")
-        (path,) = edge.get_paths()
-        # the outline is the coverage's ring, the box of the cell's M_COVR
-        extents = path.get_extents()
-        np.testing.assert_allclose(
-            [extents.x0, extents.y0, extents.x1, extents.y1], chart.coverage.bounds
-        )
-        figure.clear()
-        ax = figure.add_subplot()
-        draw_chart(ax, chart, 5.0)  # the replay's figures keep their legend as it was
-        assert "coverage" not in {c.get_gid() for c in ax.collections}
-    finally:
-        plt.close(figure)
+    figure = Figure()
+    ax = figure.subplots()
+    draw_chart(ax, chart, 5.0, coverage=True)
+    (edge,) = [c for c in ax.collections if c.get_gid() == "coverage"]
+    assert edge.get_label().startswith("chart edge")
+    (path,) = edge.get_paths()
+    # the outline is the coverage's ring, the box of the cell's M_COVR
+    extents = path.get_extents()
+    np.testing.assert_allclose(
+        [extents.x0, extents.y0, extents.x1, extents.y1], chart.coverage.bounds
+    )
+    figure.clear()
+    ax = figure.add_subplot()
+    draw_chart(ax, chart, 5.0)  # the replay's figures keep their legend as it was
+    assert "coverage" not in {c.get_gid() for c in ax.collections}
 
 
 @pytest.mark.parametrize("draught_m", [2.0, 5.0])
@@ -177,20 +171,18 @@ def test_the_depths_are_banded_around_the_draught(draught_m: float) -> None:
     than the draught, pale blue where it is deeper, with a band edge at the draught."""
     from matplotlib.colors import BoundaryNorm, to_hex
 
-    from colregs9_cli.charts.chart import load_chart
+    from colregs9_cli.charts.water import load_chart
     from colregs9_cli.report.chart_plot import DEEP_COLOURS, SHALLOW_COLOURS, draw_chart
 
     chart = load_chart([ENC])
-    figure, ax = plt.subplots()
-    try:
-        depths = draw_chart(ax, chart, draught_m)
-        assert isinstance(depths.norm, BoundaryNorm)
-        assert draught_m in list(depths.norm.boundaries)
-        colours = [to_hex(c) for c in depths.to_rgba(depths.get_array())]
-        values = np.asarray(depths.get_array())
-        shallow = values < draught_m
-        assert shallow.any() and (~shallow).any()
-        assert {c for c, s in zip(colours, shallow, strict=True) if s} <= set(SHALLOW_COLOURS)
-        assert {c for c, s in zip(colours, shallow, strict=True) if not s} <= set(DEEP_COLOURS)
-    finally:
-        plt.close(figure)
+    figure = Figure()
+    ax = figure.subplots()
+    depths = draw_chart(ax, chart, draught_m)
+    assert isinstance(depths.norm, BoundaryNorm)
+    assert draught_m in list(depths.norm.boundaries)
+    colours = [to_hex(c) for c in depths.to_rgba(depths.get_array())]
+    values = np.asarray(depths.get_array())
+    shallow = values < draught_m
+    assert shallow.any() and (~shallow).any()
+    assert {c for c, s in zip(colours, shallow, strict=True) if s} <= set(SHALLOW_COLOURS)
+    assert {c for c, s in zip(colours, shallow, strict=True) if not s} <= set(DEEP_COLOURS)

@@ -11,14 +11,10 @@ import pyogrio
 import pytest
 import shapely
 
-from colregs9_cli.charts.chart import (
-    S57_OPEN_OPTIONS,
-    Chart,
-    cell_purpose,
-    load_chart,
-    project_charts,
-    read_charts,
-)
+from colregs9_cli.charts.cells import cell_purpose
+from colregs9_cli.charts.gdal_layers import S57_OPEN_OPTIONS
+from colregs9_cli.charts.sources import read_charts
+from colregs9_cli.charts.water import Chart, load_chart, project_charts
 from colregs9_cli.geo import LocalFrame
 
 from fixture_files import SANDIEGO_ENC

@@ -10,17 +10,23 @@ import numpy as np
 import pytest
 import shapely
 
-from colregs9_cli.charts.chart import Chart, ChartLayer, load_chart, read_charts
+from colregs9_cli.charts.s57_classes import ChartLayer
+from colregs9_cli.charts.sources import read_charts
+from colregs9_cli.charts.water import Chart, load_chart
 from colregs9_cli.core.manoeuvrability import (
     ManoeuvrabilityParams,
     Restriction,
+    VesselState,
     assess_manoeuvrability,
 )
+from colregs9_cli.core.vessel_defaults import VesselDimensions
 from colregs9_cli.errors import ChartError
 from colregs9_cli.geo import LocalFrame
 
 FRAME = LocalFrame(57.0, 10.0)
 PARAMS = ManoeuvrabilityParams()
+# The target: 50 m long, 9 m in the beam, 5 m draught, all as reported by AIS.
+DIMS = VesselDimensions(50.0, 9.0, 5.0, defaulted=(), basis="")
 
 
 def _deep_everywhere(tmp_path: Path) -> Path:
@@ -52,7 +58,7 @@ def _edge_north_m(chart) -> float:
 
 def test_a_target_at_rest_10_m_inside_the_edge_is_unknown_not_restricted(chart) -> None:
     north = _edge_north_m(chart) - 10.0
-    result = assess_manoeuvrability(chart, north, 0.0, 0.0, 0.0, 50.0, 9.0, 5.0, PARAMS)
+    result = assess_manoeuvrability(chart, VesselState(north, 0.0, 0.0, 0.0), DIMS, PARAMS)
     assert len(result.restricted) == 360
     # every ellipse crosses the water's boundary, which is the chart's edge: all were red
     # when only the centres were checked against the coverage
@@ -66,7 +72,7 @@ def test_a_slow_target_along_the_edge_is_unknown_not_restricted(chart) -> None:
     # 0.5 m/s heading east, 10 m inside the north edge: 341 of 360 ellipses cross the edge
     # (all red before); the 19 that turn away from it far enough are wholly inside and blue.
     north = _edge_north_m(chart) - 10.0
-    result = assess_manoeuvrability(chart, north, 0.0, 90.0, 0.5, 50.0, 9.0, 5.0, PARAMS)
+    result = assess_manoeuvrability(chart, VesselState(north, 0.0, 90.0, 0.5), DIMS, PARAMS)
     assert result.restricted.sum() > 300
     assert not (result.restricted & result.covered).any()
     assert result.covered.any() and not result.restricted[result.covered].any()
@@ -74,14 +80,14 @@ def test_a_slow_target_along_the_edge_is_unknown_not_restricted(chart) -> None:
 
 
 def test_well_inside_a_deep_chart_is_clear(chart) -> None:
-    result = assess_manoeuvrability(chart, 0.0, 0.0, 0.0, 0.0, 50.0, 9.0, 5.0, PARAMS)
+    result = assess_manoeuvrability(chart, VesselState(0.0, 0.0, 0.0, 0.0), DIMS, PARAMS)
     assert result.covered.all() and not result.restricted.any()
     assert result.restriction is Restriction.NOT_RESTRICTED
 
 
 def test_moving_towards_the_edge_only_the_far_ellipses_are_uncovered(chart) -> None:
     north = _edge_north_m(chart) - 400.0
-    result = assess_manoeuvrability(chart, north, 0.0, 0.0, 3.0, 50.0, 9.0, 5.0, PARAMS)
+    result = assess_manoeuvrability(chart, VesselState(north, 0.0, 0.0, 3.0), DIMS, PARAMS)
     distance_to_edge = _edge_north_m(chart) - result.north_m
     # covered exactly where the whole ellipse (semi-axes 50 m and 13.5 m) is inside
     assert result.covered[distance_to_edge > 50.0 + 1.0].all()
@@ -115,7 +121,9 @@ def test_an_ellipse_touching_the_edge_from_inside_is_unknown(
 ) -> None:
     # At rest heading north, a = 50 m: from 950 m the ellipse's bow vertex lies on the north
     # edge (1,000 m). It touches the chart's edge, so it is not wholly inside: unknown, not red.
-    result = assess_manoeuvrability(_deep_square(), north_m, 0.0, 0.0, 0.0, 50.0, 9.0, 5.0, PARAMS)
+    result = assess_manoeuvrability(
+        _deep_square(), VesselState(north_m, 0.0, 0.0, 0.0), DIMS, PARAMS
+    )
     assert result.restriction is expected
     assert not (result.restricted & result.covered).any()
     assert result.covered.all() == (expected is Restriction.NOT_RESTRICTED)
@@ -139,11 +147,11 @@ def test_a_red_ellipse_inside_the_chart_still_decides_when_others_reach_past_the
     # (1,000 m); a 1 m shoal 10 m east of her track, inside the chart, makes the first
     # ellipses (half-width 13.5 m) red: the edge hides nothing that the chart does show.
     deep = _deep_square()
-    clear = assess_manoeuvrability(deep, 800.0, 0.0, 0.0, 3.0, 50.0, 9.0, 5.0, PARAMS)
+    clear = assess_manoeuvrability(deep, VesselState(800.0, 0.0, 0.0, 3.0), DIMS, PARAMS)
     assert (~clear.covered).any() and not clear.restricted[clear.covered].any()
     assert clear.restriction is Restriction.UNKNOWN
     shoal = _with_shoal(deep, shapely.box(10.0, 780.0, 80.0, 830.0))
-    result = assess_manoeuvrability(shoal, 800.0, 0.0, 0.0, 3.0, 50.0, 9.0, 5.0, PARAMS)
+    result = assess_manoeuvrability(shoal, VesselState(800.0, 0.0, 0.0, 3.0), DIMS, PARAMS)
     assert (result.restricted & result.covered).any()
     assert (~result.covered).any()
     assert result.restriction is Restriction.RESTRICTED
@@ -177,7 +185,7 @@ def _box_chart(path: Path, west: float, east: float) -> Path:
 
 
 def test_cells_on_both_sides_of_180_are_one_area(tmp_path: Path) -> None:
-    from colregs9_cli.charts.chart import project_charts
+    from colregs9_cli.charts.water import project_charts
 
     east = _box_chart(tmp_path / "east.geojson", 179.8, 180.0)
     west = _box_chart(tmp_path / "west.geojson", -180.0, -179.8)

@@ -15,7 +15,7 @@ import pytest
 import shapely
 from typer.testing import CliRunner
 
-from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.charts.water import load_chart
 from colregs9_cli.cli import app
 from colregs9_cli.errors import ChartError
 from colregs9_cli.geo import LocalFrame

@@ -14,7 +14,7 @@ import pytest
 import shapely
 from pyproj import Geod
 
-from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.charts.water import load_chart
 from colregs9_cli.jobs.chartinfo import summarise_chart
 
 from fixture_files import SANDIEGO_ENC

@@ -152,7 +152,7 @@ AIS_COMMANDS = ("replay", "stats", "ingest")
 
 @pytest.mark.parametrize("name", AIS_COMMANDS)
 def test_ais_commands_name_every_input_format_and_layout(name: str) -> None:
-    from colregs9_cli.ais.detect import LAYOUTS
+    from colregs9_cli.ais.layouts import LAYOUTS
 
     output = " ".join(_help([name]).split())
     for kind in ("DMA CSV", "MarineCadastre CSV", "NMEA", "Parquet"):
@@ -170,7 +170,7 @@ def test_ais_commands_name_every_input_format_and_layout(name: str) -> None:
     [("replay", "--chart CHART"), ("chart", "CHART..."), ("demo", "--chart CHART")],
 )
 def test_chart_inputs_name_every_chart_format(name: str, marker: str) -> None:
-    from colregs9_cli.charts.chart import S57_SUFFIXES, VECTOR_SUFFIXES
+    from colregs9_cli.charts.read import S57_SUFFIXES, VECTOR_SUFFIXES
 
     output = " ".join(_help([name]).split())
     chart_help = output.split(marker, 1)[1].split(" --", 1)[0]

@@ -18,7 +18,7 @@ from colregs9_cli.core.colregs import (
     evaluate_colregs,
     relative_bearing_deg,
 )
-from colregs9_cli.core.replay_params import CourseSource
+from colregs9_cli.core.tracks import CourseSource
 from colregs9_cli.errors import ParameterError, QueryError
 
 PARAMS = ColregsParams()

@@ -14,7 +14,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from colregs9_cli.ais import columns, csv_chunks, load
+from colregs9_cli.ais import csv_chunks, row_pipeline
+from colregs9_cli.ais.layouts import LAYOUTS
 from colregs9_cli.ais.load import AisData, load_ais
 from colregs9_cli.errors import InputFileError
 from colregs9_cli.query import Query, Region, load_query
@@ -276,15 +277,17 @@ def test_text_in_a_column_converted_only_for_kept_rows(tmp_path: Path) -> None:
 def _read_chunks(path: Path) -> Iterator[csv_chunks.CsvChunk]:
     """The chunks of a DMA 26-column file, read as ``load_ais`` reads them, one at a time."""
     names = path.read_text().splitlines()[0].lower().lstrip("# ").split(",")
+    columns = LAYOUTS["dma26"].csv_columns
+    assert columns is not None
     with path.open("rb") as stream:
         yield from csv_chunks.read_chunks(
             stream,
             names,
             True,
-            row_columns=columns.dma_row_columns(True),
-            all_columns=columns.dma_read_columns(True),
-            numeric=columns.DMA_NUMERIC_COLUMNS,
-            whole=columns.DMA_WHOLE_COLUMNS,
+            row_columns=columns.row_columns,
+            all_columns=columns.columns,
+            numeric=columns.numeric,
+            whole=columns.whole,
         )
 
 
@@ -358,6 +361,6 @@ def test_rows_set_aside_give_the_same_result_in_any_batch(
     query = Query(name="box", region=Region(*_BOXES[fixture])) if boxed else None
     whole = load_ais([fixture], query=query)
     assert whole.rows_in_query > 0
-    monkeypatch.setattr(load, "_SET_ASIDE_BYTES", 1)
+    monkeypatch.setattr(row_pipeline, "_SET_ASIDE_BYTES", 1)
     monkeypatch.setattr(csv_chunks, "CHUNK_BYTES", 400)
     _same(load_ais([fixture], query=query), whole)

@@ -19,12 +19,11 @@ from colregs9_cli.core.encounters import (
     encounter_series,
     find_encounters,
     trigger_mask,
-    velocity_mps,
 )
-from colregs9_cli.core.replay_params import ReplayParams, replay_params_from_table
 from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.errors import NoDataError, ParameterError, QueryError
-from colregs9_cli.geo import LocalFrame
+from colregs9_cli.geo import LocalFrame, velocity_mps
+from colregs9_cli.jobs.replay_params import ReplayParams, replay_params_from_table
 from colregs9_cli.units import (
     knots_to_mps,
     metres_to_nautical_miles,
@@ -64,7 +63,7 @@ def straight_track(
 
 
 def tracks_of(*frames: pd.DataFrame, params: ReplayParams = PARAMS):
-    return build_tracks(pd.concat(frames, ignore_index=True), FRAME, params)
+    return build_tracks(pd.concat(frames, ignore_index=True), FRAME, params.tracks)
 
 
 # --- CPA / TCPA ---------------------------------------------------------------------------
@@ -101,7 +100,7 @@ def test_cpa_tcpa_without_relative_motion_is_the_current_range() -> None:
 def test_cpa_tcpa_unknown_velocity_is_nan() -> None:
     cpa_m, tcpa_s = cpa_tcpa(100.0, 0.0, np.nan, 1.0)
     assert np.isnan(cpa_m) and np.isnan(tcpa_s)
-    assert not trigger_mask(cpa_m, tcpa_s, np.nan, PARAMS)
+    assert not trigger_mask(cpa_m, tcpa_s, np.nan, PARAMS.encounters)
 
 
 coordinate = st.floats(-20_000, 20_000, allow_nan=False)
@@ -163,7 +162,7 @@ def test_parallel_courses_at_equal_speed_never_trigger(
     rel_v = (tgt_v[0] - own_v[0], tgt_v[1] - own_v[1])
     cpa_m, tcpa_s = cpa_tcpa(tgt_n - own_n, tgt_e - own_e, *rel_v)
     assert cpa_m == pytest.approx(math.hypot(tgt_n - own_n, tgt_e - own_e))
-    assert not trigger_mask(cpa_m, tcpa_s, math.hypot(*rel_v), PARAMS)
+    assert not trigger_mask(cpa_m, tcpa_s, math.hypot(*rel_v), PARAMS.encounters)
 
 
 def test_parallel_convoy_within_cpa_req_gives_no_triggered_encounter() -> None:
@@ -171,7 +170,7 @@ def test_parallel_convoy_within_cpa_req_gives_no_triggered_encounter() -> None:
     tracks = tracks_of(
         straight_track(1, 0.0, 0.0, 45.0, 5.0, 600), straight_track(2, 0.0, 100.0, 45.0, 5.0, 600)
     )
-    search = find_encounters(tracks, PARAMS)
+    search = find_encounters(tracks, PARAMS.encounters)
     assert len(search.encounters) == 2  # a candidate pair from both seats ...
     assert search.triggered == ()  # ... that never triggers
 
@@ -256,7 +255,7 @@ def head_to_head(offset_m: float) -> tuple[pd.DataFrame, pd.DataFrame]:
 def test_pair_entering_and_leaving_range_without_trigger() -> None:
     # Range √((10000 − 10t)² + 500²) ≤ 3704 for |10000 − 10t| ≤ √(3704² − 500²) = 3670.10,
     # i.e. t in [632.99, 1367.01]: steps 633..1367. CPA 500 m ≥ 150 m: no trigger.
-    search = find_encounters(tracks_of(*head_to_head(500.0)), PARAMS, own_mmsi=[1])
+    search = find_encounters(tracks_of(*head_to_head(500.0)), PARAMS.encounters, own_mmsi=[1])
     (encounter,) = search.encounters
     assert encounter.start_step - T0_S == 633
     assert encounter.end_step - T0_S == 1367
@@ -270,7 +269,7 @@ def test_pair_entering_and_leaving_range_without_trigger() -> None:
 def test_trigger_step_is_exact() -> None:
     # Offset 100 m: CPA 100 < 150. TCPA = (10000 − 10t)/10 = 1000 − t ≤ 180 first at t = 820.
     # In range from √(3704² − 100²) = 3702.65: t ≥ 629.74 → 630; to t ≤ 1370.26 → 1370.
-    search = find_encounters(tracks_of(*head_to_head(100.0)), PARAMS, own_mmsi=[1])
+    search = find_encounters(tracks_of(*head_to_head(100.0)), PARAMS.encounters, own_mmsi=[1])
     (encounter,) = search.encounters
     assert (encounter.start_step - T0_S, encounter.end_step - T0_S) == (630, 1370)
     # The tracks are laid in the map frame, the geometry is geodesic: they differ by parts in
@@ -292,7 +291,9 @@ def test_crossing_trigger_step_is_the_ceiling_of_tcpa_act_before_collision() -> 
     speed = 10 * 1852 / 3600
     own = straight_track(1, -2000.0, 0.0, 0.0, speed, 400)
     target = straight_track(2, 0.0, 2000.0, 270.0, speed, 400)
-    (encounter,) = find_encounters(tracks_of(own, target), PARAMS, own_mmsi=[2]).encounters
+    (encounter,) = find_encounters(
+        tracks_of(own, target), PARAMS.encounters, own_mmsi=[2]
+    ).encounters
     assert (encounter.own_mmsi, encounter.target_mmsi) == (2, 1)
     assert encounter.trigger_step - T0_S == math.ceil(2000 / speed - 180)
     assert encounter.cpa_m_at_trigger == pytest.approx(0.0, abs=1e-3)
@@ -300,7 +301,7 @@ def test_crossing_trigger_step_is_the_ceiling_of_tcpa_act_before_collision() -> 
 
 def test_own_ship_seats() -> None:
     tracks = tracks_of(*head_to_head(100.0), straight_track(3, 40_000.0, 0.0, 90.0, 5.0, 2000))
-    both = find_encounters(tracks, PARAMS)
+    both = find_encounters(tracks, PARAMS.encounters)
     assert [(e.own_mmsi, e.target_mmsi) for e in both.encounters] == [(1, 2), (2, 1)]
     first, second = both.encounters
     assert (first.start_step, first.end_step, first.trigger_step) == (
@@ -309,25 +310,27 @@ def test_own_ship_seats() -> None:
         second.trigger_step,
     )
     assert first.cpa_m_at_trigger == second.cpa_m_at_trigger
-    only_two = find_encounters(tracks, PARAMS, own_mmsi=[2])
+    only_two = find_encounters(tracks, PARAMS.encounters, own_mmsi=[2])
     assert [(e.own_mmsi, e.target_mmsi) for e in only_two.encounters] == [(2, 1)]
-    far_away = find_encounters(tracks, PARAMS, own_mmsi=[3])
+    far_away = find_encounters(tracks, PARAMS.encounters, own_mmsi=[3])
     assert far_away.encounters == ()
-    pair_seats = find_encounters(tracks, PARAMS, own_mmsi=[1, 2])
+    pair_seats = find_encounters(tracks, PARAMS.encounters, own_mmsi=[1, 2])
     assert pair_seats.encounters == both.encounters
 
 
 def test_unknown_own_mmsi_is_a_clear_error() -> None:
     tracks = tracks_of(*head_to_head(100.0))
     with pytest.raises(NoDataError, match="own MMSI 999"):
-        find_encounters(tracks, PARAMS, own_mmsi=[1, 999])
+        find_encounters(tracks, PARAMS.encounters, own_mmsi=[1, 999])
 
 
 def test_slow_vessels_are_not_candidates() -> None:
     own, target = head_to_head(100.0)
     target["sog_kn"] = 0.4  # reported below min_sog_kn although the positions move
-    assert find_encounters(tracks_of(own, target), PARAMS).encounters == ()
-    assert len(find_encounters(tracks_of(own, target), ReplayParams(min_sog_kn=0.3)).encounters)
+    assert find_encounters(tracks_of(own, target), PARAMS.encounters).encounters == ()
+    assert len(
+        find_encounters(tracks_of(own, target), ReplayParams(min_sog_kn=0.3).encounters).encounters
+    )
 
 
 def test_a_break_in_candidacy_makes_two_encounters() -> None:
@@ -339,7 +342,7 @@ def test_a_break_in_candidacy_makes_two_encounters() -> None:
         target["timestamp"] <= T0 + pd.Timedelta(seconds=900)
     )
     target.loc[slow, "sog_kn"] = 0.0
-    search = find_encounters(tracks_of(own, target), PARAMS, own_mmsi=[1])
+    search = find_encounters(tracks_of(own, target), PARAMS.encounters, own_mmsi=[1])
     spans = [(e.start_step - T0_S, e.end_step - T0_S) for e in search.encounters]
     assert spans == [(630, 699), (901, 1370)]
     assert [e.trigger_step is not None for e in search.encounters] == [False, True]
@@ -351,9 +354,9 @@ def test_batches_join_runs_across_their_boundaries(monkeypatch: pytest.MonkeyPat
         straight_track(3, -4000.0, 300.0, 10.0, 6.0, 2000),
         straight_track(4, 3000.0, 2000.0, 250.0, 4.0, 2000),
     )
-    whole = find_encounters(tracks, PARAMS)
+    whole = find_encounters(tracks, PARAMS.encounters)
     monkeypatch.setattr(encounters_module, "_POINTS_PER_BATCH", 200)  # 50 steps per batch
-    pieces = find_encounters(tracks, PARAMS)
+    pieces = find_encounters(tracks, PARAMS.encounters)
     assert pieces.encounters == whole.encounters
     assert pieces.candidate_pair_steps == whole.candidate_pair_steps
     assert len(whole.triggered) >= 2
@@ -361,7 +364,7 @@ def test_batches_join_runs_across_their_boundaries(monkeypatch: pytest.MonkeyPat
 
 def test_encounter_series_orients_own_and_target() -> None:
     tracks = tracks_of(*head_to_head(100.0))
-    encounter = find_encounters(tracks, PARAMS, own_mmsi=[2]).encounters[0]
+    encounter = find_encounters(tracks, PARAMS.encounters, own_mmsi=[2]).encounters[0]
     series = encounter_series(tracks, encounter, from_step=encounter.trigger_step)
     assert len(series) == encounter.end_step - encounter.trigger_step + 1
     for column in SERIES_VESSEL_COLUMNS:
@@ -406,7 +409,7 @@ def test_find_encounters_agrees_with_a_direct_computation(seed: int) -> None:
         for m in range(1, 6)
     ]
     tracks = tracks_of(*frames)
-    for encounter in find_encounters(tracks, PARAMS).encounters:
+    for encounter in find_encounters(tracks, PARAMS.encounters).encounters:
         series = encounter_series(tracks, encounter)
         assert len(series) == encounter.end_step - encounter.start_step + 1
         assert (series["range_m"] <= PARAMS.candidate_range_m).all()
@@ -418,7 +421,7 @@ def test_find_encounters_agrees_with_a_direct_computation(seed: int) -> None:
                 )
             )
         )
-        fires = trigger_mask(series["cpa_m"], series["tcpa_s"], rel_speed, PARAMS)
+        fires = trigger_mask(series["cpa_m"], series["tcpa_s"], rel_speed, PARAMS.encounters)
         if encounter.triggered:
             first = int(np.argmax(fires))
             assert fires.any() and series["step"].iloc[first] == encounter.trigger_step
@@ -508,8 +511,8 @@ def test_true_collision_course_far_from_the_central_meridian_has_cpa_zero() -> N
     speed = 5.0
     own = geodesic_track(1, 56.0, 12.0, 0.0, speed, 600)
     target = geodesic_track(2, 56.0, 12.0, 270.0, speed, 600)
-    tracks = build_tracks(pd.concat([own, target], ignore_index=True), frame, PARAMS)
-    (encounter,) = find_encounters(tracks, PARAMS, own_mmsi=[1]).encounters
+    tracks = build_tracks(pd.concat([own, target], ignore_index=True), frame, PARAMS.tracks)
+    (encounter,) = find_encounters(tracks, PARAMS.encounters, own_mmsi=[1]).encounters
     assert encounter.triggered
     assert encounter.tcpa_s_at_trigger == pytest.approx(180.0, abs=1.0)
     assert encounter.cpa_m_at_trigger == pytest.approx(0.0, abs=2.0)

@@ -118,8 +118,7 @@ def test_shapes_across_the_antimeridian_are_cut_there_in_wgs84() -> None:
 
 
 def test_a_vessel_at_rest_without_a_course_has_no_velocity() -> None:
-    from colregs9_cli.core.encounters import velocity_mps
-    from colregs9_cli.geo import velocity_ecef_mps
+    from colregs9_cli.geo import velocity_ecef_mps, velocity_mps
 
     at_rest = velocity_ecef_mps([57.0, 57.0], [10.0, 10.0], [0.0, 2.0], [np.nan, np.nan])
     assert np.array_equal(at_rest[0], np.zeros(3))

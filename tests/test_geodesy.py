@@ -17,10 +17,10 @@ import shapely
 from pyproj import Geod
 
 from colregs9_cli.core.encounters import find_encounters
-from colregs9_cli.core.replay_params import ReplayParams
 from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.jobs.replay import run_replay
+from colregs9_cli.jobs.replay_params import ReplayParams
 
 GEOD = Geod(ellps="WGS84")
 T0 = pd.Timestamp("2024-01-01T00:00:00Z")
@@ -91,8 +91,8 @@ def test_range_and_cpa_agree_with_geod(lat: float, lon: float, frame: LocalFrame
     reports = pd.concat(
         [_reports(1, own_start, seconds), _reports(2, target_start, seconds)], ignore_index=True
     )
-    tracks = build_tracks(reports, frame, PARAMS)
-    (encounter,) = find_encounters(tracks, PARAMS, own_mmsi=[1]).triggered
+    tracks = build_tracks(reports, frame, PARAMS.tracks)
+    (encounter,) = find_encounters(tracks, PARAMS.encounters, own_mmsi=[1]).triggered
     assert encounter.range_m_at_trigger is not None and encounter.cpa_m_at_trigger is not None
     assert encounter.trigger is not None
     trigger_s = (encounter.trigger - T0).total_seconds()

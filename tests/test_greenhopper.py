@@ -20,7 +20,7 @@ import pytest
 import shapely
 from typer.testing import CliRunner
 
-from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.charts.water import load_chart
 from colregs9_cli.cli import app
 from colregs9_cli.core.manoeuvrability import Restriction, ellipse_polygons
 from colregs9_cli.core.replay_results import ReplayResult

@@ -12,12 +12,14 @@ import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from colregs9_cli.charts.chart import Chart, ChartLayer, load_chart
+from colregs9_cli.charts.s57_classes import ChartLayer
+from colregs9_cli.charts.water import Chart, load_chart
 from colregs9_cli.core.manoeuvrability import (
     ManoeuvrabilityParams,
     Restriction,
     RestrictionPolicy,
     SwingModel,
+    VesselState,
     assess_manoeuvrability,
     ellipse_polygons,
     reference_vessels,
@@ -26,11 +28,14 @@ from colregs9_cli.core.manoeuvrability import (
     turning_arcs,
     verdict,
 )
+from colregs9_cli.core.vessel_defaults import VesselDimensions
 from colregs9_cli.errors import ParameterError, QueryError
 from colregs9_cli.geo import LocalFrame
 
 ENC = Path(__file__).resolve().parents[1] / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
 SEVEN_KN_MPS = 7.0 * 1852.0 / 3600.0
+# The test target: 50 m long, 9 m in the beam, 5 m draught, all as reported by AIS.
+DIMS = VesselDimensions(50.0, 9.0, 5.0, defaulted=(), basis="")
 
 # The paper's Table "Overview of vessels used for calculation of rate of swing", copied from
 # paper.tex by hand: type, l, b, rudder, δ_max, r_turn.
@@ -123,10 +128,10 @@ def test_arc_points_lie_on_the_turning_circle_within_the_path_length(
 
 def test_alpha_scales_the_turn_radius_by_its_inverse() -> None:
     full = assess_manoeuvrability(
-        None, 0.0, 0.0, 0.0, 3.0, 50.0, 9.0, 5.0, ManoeuvrabilityParams(alpha=1.0)
+        None, VesselState(0.0, 0.0, 0.0, 3.0), DIMS, ManoeuvrabilityParams(alpha=1.0)
     )
     scaled = assess_manoeuvrability(
-        None, 0.0, 0.0, 0.0, 3.0, 50.0, 9.0, 5.0, ManoeuvrabilityParams(alpha=0.4)
+        None, VesselState(0.0, 0.0, 0.0, 3.0), DIMS, ManoeuvrabilityParams(alpha=0.4)
     )
     assert scaled.turn_radius_m / full.turn_radius_m == pytest.approx(2.5)
     # The paper's δ' = 0.4 · 0.2 deg/m = 0.08 deg/m, r = 1 / δ'_rad ≈ 716.2 m.
@@ -169,7 +174,7 @@ def _square_chart(shoal_south_m: float) -> Chart:
 def _at_rest(chart: Chart, **params: object) -> object:
     # At rest, heading north: every projected ellipse is the one at the origin, a = 50 m.
     return assess_manoeuvrability(
-        chart, 0.0, 0.0, 0.0, 0.0, 50.0, 9.0, 5.0, ManoeuvrabilityParams(**params)
+        chart, VesselState(0.0, 0.0, 0.0, 0.0), DIMS, ManoeuvrabilityParams(**params)
     )
 
 
@@ -191,7 +196,7 @@ def test_a_vessel_at_rest_is_assessed_where_she_lies() -> None:
 
 def test_no_chart_gives_unknown() -> None:
     assessment = assess_manoeuvrability(
-        None, 0.0, 0.0, 0.0, 3.0, 50.0, 9.0, 5.0, ManoeuvrabilityParams()
+        None, VesselState(0.0, 0.0, 0.0, 3.0), DIMS, ManoeuvrabilityParams()
     )
     assert assessment.restriction is Restriction.UNKNOWN
     assert not assessment.covered.any()
@@ -224,9 +229,9 @@ def test_restriction_flags_are_translation_invariant(
         ),
     )
     params = ManoeuvrabilityParams(horizon_s=60.0)
-    here = assess_manoeuvrability(chart, north, east, course, 3.0, 50.0, 9.0, 5.0, params)
+    here = assess_manoeuvrability(chart, VesselState(north, east, course, 3.0), DIMS, params)
     there = assess_manoeuvrability(
-        moved, north + shift_north, east + shift_east, course, 3.0, 50.0, 9.0, 5.0, params
+        moved, VesselState(north + shift_north, east + shift_east, course, 3.0), DIMS, params
     )
     # A translated chart can move a vertex by a rounding error; ellipses within a millimetre
     # of the shoal are the only ones allowed to differ.
@@ -295,7 +300,7 @@ def test_arcs_leaving_the_extent_mark_their_positions_uncovered(
     position is covered only when its whole ellipse is inside the square."""
     chart = _square_chart(-500.0)  # the shoal is south of every arc
     assessment = assess_manoeuvrability(
-        chart, start_north_m, 0.0, 0.0, SEVEN_KN_MPS, 50.0, 9.0, 5.0, ManoeuvrabilityParams()
+        chart, VesselState(start_north_m, 0.0, 0.0, SEVEN_KN_MPS), DIMS, ManoeuvrabilityParams()
     )
     ellipse_north_edge = shapely.bounds(assessment.ellipses)[:, 3]
     reaches_out = ellipse_north_edge > 1000.0
@@ -374,9 +379,19 @@ def test_params_reject_unknown_keys_and_bad_values() -> None:
 def test_bad_target_values_are_errors() -> None:
     params = ManoeuvrabilityParams()
     with pytest.raises(ParameterError, match="draught_m -1"):
-        assess_manoeuvrability(None, 0.0, 0.0, 0.0, 3.0, 50.0, 9.0, -1.0, params)
+        assess_manoeuvrability(
+            None,
+            VesselState(0.0, 0.0, 0.0, 3.0),
+            VesselDimensions(50.0, 9.0, -1.0, defaulted=(), basis=""),
+            params,
+        )
     with pytest.raises(ParameterError, match="length_m 0"):
-        assess_manoeuvrability(None, 0.0, 0.0, 0.0, 3.0, 0.0, 9.0, 5.0, params)
+        assess_manoeuvrability(
+            None,
+            VesselState(0.0, 0.0, 0.0, 3.0),
+            VesselDimensions(0.0, 9.0, 5.0, defaulted=(), basis=""),
+            params,
+        )
 
 
 # The real ENC, Annapolis / Severn River.
@@ -421,7 +436,7 @@ def test_a_vessel_heading_along_the_severn_channel_is_restricted(enc: Chart) -> 
     assert 130.0 < axis_deg < 160.0
     for course in (axis_deg, axis_deg + 180.0):
         assessment = assess_manoeuvrability(
-            enc, north, east, course % 360, SEVEN_KN_MPS, 50.0, 9.0, 5.0, ManoeuvrabilityParams()
+            enc, VesselState(north, east, course % 360, SEVEN_KN_MPS), DIMS, ManoeuvrabilityParams()
         )
         assert assessment.restriction is Restriction.RESTRICTED
         # She starts clear in the channel; the turns run her out of it.
@@ -433,7 +448,7 @@ def test_a_vessel_heading_along_the_severn_channel_is_restricted(enc: Chart) -> 
 def test_the_same_vessel_in_the_widest_deep_water_is_not(enc: Chart, course: float) -> None:
     north, east = _widest_deep_water(enc)
     assessment = assess_manoeuvrability(
-        enc, north, east, course, SEVEN_KN_MPS, 50.0, 9.0, 5.0, ManoeuvrabilityParams()
+        enc, VesselState(north, east, course, SEVEN_KN_MPS), DIMS, ManoeuvrabilityParams()
     )
     assert assessment.restriction is Restriction.NOT_RESTRICTED
     assert not assessment.restricted.any()
@@ -441,7 +456,7 @@ def test_the_same_vessel_in_the_widest_deep_water_is_not(enc: Chart, course: flo
 
 def test_outside_the_chart_is_unknown(enc: Chart) -> None:
     assessment = assess_manoeuvrability(
-        enc, 20_000.0, 20_000.0, 0.0, SEVEN_KN_MPS, 50.0, 9.0, 5.0, ManoeuvrabilityParams()
+        enc, VesselState(20_000.0, 20_000.0, 0.0, SEVEN_KN_MPS), DIMS, ManoeuvrabilityParams()
     )
     assert assessment.restriction is Restriction.UNKNOWN
     assert not assessment.covered.any()

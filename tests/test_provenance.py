@@ -14,7 +14,7 @@ import pytest
 
 from colregs9_cli.ais.load import load_ais
 from colregs9_cli.ais.sources import inspect_source, open_data
-from colregs9_cli.provenance import charts_manifest
+from colregs9_cli.charts.provenance import charts_manifest
 
 from fixture_files import DMA26, MARINECADASTRE, MODELLED_CHART, NMEA, SANDIEGO_ENC
 

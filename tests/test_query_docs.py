@@ -10,7 +10,7 @@ from colregs9_cli.ais.time_sources import IngestParams
 from colregs9_cli.config import dataclass_from_table
 from colregs9_cli.core.colregs import ColregsParams, colregs_params_from_table
 from colregs9_cli.core.manoeuvrability import ManoeuvrabilityParams
-from colregs9_cli.core.replay_params import ReplayParams, replay_params_from_table
+from colregs9_cli.jobs.replay_params import ReplayParams, replay_params_from_table
 
 from fixture_files import ROOT
 

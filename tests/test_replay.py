@@ -4,7 +4,7 @@ with a chart where the target is restricted (D3 → D4).
 The CPA/TCPA checks recompute every encounter from the two vessels' raw reports around the
 trigger with plain numpy/pyproj (decoded by the NMEA reader, not by the replay pipeline):
 position linear in time between the bracketing reports, SOG linear, COG along the shorter
-arc (the interpolation rules of DESIGN §5 written out by hand), the velocity turned from true
+arc (docs/design.md §5, written out by hand), the velocity turned from true
 to grid north by projecting a 1 m step along the COG (pyproj Geod), then
 ``TCPA = −p·v/|v|²``, ``CPA = |p + v·TCPA|``.
 """
@@ -22,17 +22,17 @@ from pyproj import Geod, Transformer
 
 from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
-from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.charts.water import load_chart
 from colregs9_cli.core.manoeuvrability import (
     RestrictionPolicy,
     SwingModel,
     target_rate_of_swing_deg_per_m,
     verdict,
 )
-from colregs9_cli.core.replay_params import ReplayParams
-from colregs9_cli.core.replay_results import ENCOUNTER_COLUMNS, PAIR_COLUMNS
+from colregs9_cli.core.rows import ENCOUNTER_COLUMNS, PAIR_COLUMNS
 from colregs9_cli.errors import ParameterError
 from colregs9_cli.jobs.replay import run_params, run_replay
+from colregs9_cli.jobs.replay_params import ReplayParams
 from colregs9_cli.jobs.simulate import simulate_scenario
 from colregs9_cli.query import everything_query
 
@@ -241,7 +241,7 @@ def test_national_time_series_runs_from_the_trigger_until_the_pass(national) -> 
         assert (series["tcpa_s"].iloc[:-1] >= 0.0).all()
         assert (series["tcpa_s"].iloc[-1] < 0.0) == summary.data_covers_cpa
         assert (np.diff(series["step"]) == 1).all()
-        horizon = pd.Timedelta(seconds=summary.tcpa_s + national.params.replay.tcpa_act_s + 1)
+        horizon = pd.Timedelta(seconds=summary.tcpa_s + national.params.encounters.tcpa_act_s + 1)
         assert series["timestamp"].iloc[-1] <= summary.trigger_utc + horizon
         assert series["automaton_path"].iloc[0] == summary.automaton_path
         # the situation is held from the trigger; the instantaneous one may change
@@ -407,7 +407,7 @@ def test_estimates_are_fresh_wherever_g_d_reaches_d3(restricted, not_restricted)
         reaches_d3 = series["automaton_path"].str.contains("D3")
         age_s = (series["timestamp"] - series["target_assessed_utc"]).dt.total_seconds()
         assert reaches_d3.any()
-        assert (age_s[reaches_d3] < result.params.replay.reassess_every_s).all()
+        assert (age_s[reaches_d3] < result.params.rule9.reassess_every_s).all()
         assert (age_s >= 0).all()
 
 

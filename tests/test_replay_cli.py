@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
-from colregs9_cli.core.replay_results import ENCOUNTER_COLUMNS
+from colregs9_cli.core.rows import ENCOUNTER_COLUMNS
 
 from fixture_files import NMEA, ROOT
 

@@ -11,9 +11,10 @@ import matplotlib.image
 import numpy as np
 import pandas as pd
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from colregs9_cli.charts.chart import load_chart
-from colregs9_cli.core.replay_results import ENCOUNTER_COLUMNS, SERIES_COLUMNS
+from colregs9_cli.charts.water import load_chart
+from colregs9_cli.core.rows import ENCOUNTER_COLUMNS, SERIES_COLUMNS
 from colregs9_cli.jobs.replay import run_replay
 from colregs9_cli.jobs.simulate import simulate_scenario
 from colregs9_cli.report.chart_plot import DEPTH_LABEL, RESTRICTED_COLOUR
@@ -378,7 +379,7 @@ def test_figure_layout_keeps_the_plot_clear(restricted) -> None:
     # The legend is below the axes, not on them.
     assert ax.get_legend() is None
     (legend,) = figure.legends
-    figure.canvas.draw()
+    FigureCanvasAgg(figure).draw()
     renderer = figure.canvas.get_renderer()
     assert legend.get_window_extent(renderer).y1 <= ax.get_window_extent(renderer).y0
     labels = [t.get_text() for t in legend.get_texts()]
@@ -418,7 +419,7 @@ def test_figure_axes_read_latitude_and_longitude_with_a_scale_bar(restricted) ->
     frame = restricted.frame
     figure = encounter_figure(outcome, None, ukc_m=0.0, frame=frame)
     ax = figure.axes[0]
-    figure.canvas.draw()
+    FigureCanvasAgg(figure).draw()
     (x_low, x_high), (y_low, y_high) = ax.get_xlim(), ax.get_ylim()
     middle_north, middle_east = (y_low + y_high) / 2, (x_low + x_high) / 2
     for tick in ax.get_xticklabels():

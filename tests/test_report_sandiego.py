@@ -12,9 +12,10 @@ import pandas as pd
 import pyogrio
 import pytest
 import shapely
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.text import Text
 
-from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.charts.water import load_chart
 from colregs9_cli.report.chart_plot import NOT_CHARTED_LABEL
 from colregs9_cli.report.html_report import overview_figure, pair_numbers, place_labels
 from colregs9_cli.report.replay_report import DEFAULTED_NOTE, encounter_figure
@@ -118,7 +119,7 @@ def test_the_map_numbers_the_pairs_as_the_table_and_reads_in_degrees(sandiego) -
     result, chart = sandiego
     figure = overview_figure(result, chart)
     ax = figure.axes[0]
-    figure.canvas.draw()
+    FigureCanvasAgg(figure).draw()
     numbers = pair_numbers(result)
     labels = {text.get_text(): text for text in ax.texts}
     assert set(labels) == {str(n) for n in numbers.values()} == {str(n) for n in range(1, 20)}

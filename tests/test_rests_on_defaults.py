@@ -7,9 +7,11 @@ import pytest
 
 from colregs9_cli.core.colregs import Role, Situation
 from colregs9_cli.core.manoeuvrability import Restriction
+from colregs9_cli.core.pair import rests_on_defaults
 from colregs9_cli.core.rule9 import DecidingRule, decide_pair
 from colregs9_cli.core.vessel_defaults import VesselDimensions
-from colregs9_cli.jobs.replay import rests_on_defaults
+
+from seat_checks import swapped
 
 KNOWN = VesselDimensions(50.0, 9.0, 5.0, defaulted=(), basis="")
 DEFAULTED = VesselDimensions(12.0, 4.0, 1.5, defaulted=("draught_m",), basis="Class B")
@@ -26,14 +28,14 @@ def _rests(
 ) -> tuple[bool, DecidingRule]:
     verdict = decide_pair(situation, roles, nav_status, estimates, STATUSES)
     flag = rests_on_defaults(verdict, dimensions, estimates, nav_status, STATUSES)
-    swapped = rests_on_defaults(
-        verdict.swapped(),
+    other_seat = rests_on_defaults(
+        swapped(verdict),
         (dimensions[1], dimensions[0]),
         (estimates[1], estimates[0]),
         (nav_status[1], nav_status[0]),
         STATUSES,
     )
-    assert flag == swapped, "the flag must not depend on the vessels' order"
+    assert flag == other_seat, "the flag must not depend on the vessels' order"
     return flag, verdict.deciding_rule
 
 

@@ -28,6 +28,8 @@ from colregs9_cli.core.rule9 import (
     step,
 )
 
+from seat_checks import swapped
+
 D1, D2, D3, D4 = State.D1, State.D2, State.D3, State.D4
 
 # The six arrows of the figure, read off tikz/automaton_A.tex in ../shared/paper.tex.
@@ -282,7 +284,7 @@ def test_pair_final_roles_are_the_same_from_both_seats(
     assert verdict.deciding_rule is rule
     assert verdict.both_restricted is both
     mirrored = decide_pair(situation, roles[::-1], nav[::-1], estimates[::-1])
-    assert mirrored == verdict.swapped()
+    assert mirrored == swapped(verdict)
     assert mirrored.role_final == final[::-1]
 
 
@@ -319,4 +321,4 @@ def test_every_pair_verdict_is_consistent(
         assert verdict.role_final == roles and verdict.deciding_rule is R13
     assert verdict.rule9_applied is (verdict.deciding_rule is R9)
     mirrored = decide_pair(situation, roles[::-1], (nav_b, nav_a), (estimate_b, estimate_a))
-    assert mirrored == verdict.swapped()
+    assert mirrored == swapped(verdict)

@@ -12,7 +12,7 @@ import pytest
 from shapely.geometry import Point
 from typer.testing import CliRunner
 
-from colregs9_cli.charts.chart import load_chart
+from colregs9_cli.charts.water import load_chart
 from colregs9_cli.cli import app
 from colregs9_cli.errors import QueryError
 from colregs9_cli.geo import LocalFrame

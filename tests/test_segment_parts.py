@@ -14,9 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_replay_cli import write_dma
 
-from colregs9_cli.core.replay_params import ReplayParams
 from colregs9_cli.jobs.replay import REPLAY_COLUMNS
 from colregs9_cli.jobs.replay_input import ReplayInput, open_replay_input, segment_input_part
+from colregs9_cli.jobs.replay_params import ReplayParams
 from colregs9_cli.jobs.slabs import Segmentation, merge_parts, segment_part, slabs_of_frame
 from colregs9_cli.query import everything_query
 

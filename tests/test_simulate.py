@@ -10,9 +10,10 @@ import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
+from colregs9_cli.ais.layouts import DMA_COLUMNS
 from colregs9_cli.cli import app
 from colregs9_cli.geo import LocalFrame
-from colregs9_cli.jobs.simulate import DMA_COLUMNS, simulate_scenario
+from colregs9_cli.jobs.simulate import simulate_scenario
 from colregs9_cli.units import knots_to_mps
 
 from fixture_files import DMA26

@@ -12,7 +12,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_replay_cli import write_dma
 
-from colregs9_cli.core.replay_params import ReplayParams
 from colregs9_cli.core.tracks import (
     NO_TRACK_STATS,
     REPORT_COLUMNS,
@@ -20,6 +19,7 @@ from colregs9_cli.core.tracks import (
     segment_reports,
 )
 from colregs9_cli.jobs.replay import run_replay
+from colregs9_cli.jobs.replay_params import ReplayParams
 
 from fixture_files import NMEA, SANDIEGO_AIS, SANDIEGO_ENC
 
@@ -174,13 +174,13 @@ def _reports(draw) -> pd.DataFrame:
 @given(reports=_reports(), slab_s=st.sampled_from([5.0, 20.0, 60.0, 300.0, 1000.0]))
 def test_segmentation_in_slabs_decides_every_report_as_in_one_go(reports, slab_s) -> None:
     params = ReplayParams()
-    whole = segment_reports(reports, empty_carry(), params)
+    whole = segment_reports(reports, empty_carry(), params.tracks)
     slab = np.floor(reports["t_s"].to_numpy() / slab_s).astype(np.int64)
     indices = np.unique(slab)
     carry, stats, kept = empty_carry(), NO_TRACK_STATS, []
     for n, index in enumerate(indices):
         until = None if n == len(indices) - 1 else (index + 1) * slab_s
-        part = segment_reports(reports[slab == index], carry, params, until)
+        part = segment_reports(reports[slab == index], carry, params.tracks, until)
         carry, stats = part.carry, stats + part.stats
         kept.append(part.kept)
     streamed = pd.concat(kept, ignore_index=True)

@@ -1,7 +1,7 @@
 """`colregs9 stats` end to end on the real fixtures, checked against independent readings.
 
 The expected figures are never taken from colregs9's readers: the CSV fixtures are read again
-here with plain pandas and the cleaning rules of DESIGN §4 written out by hand, and the NMEA
+here with plain pandas and the cleaning rules of docs/design.md §4 written out by hand, and the NMEA
 fixture is decoded with pyais directly (see ``_nmea_vessels``).
 """
 

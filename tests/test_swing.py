@@ -5,13 +5,9 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
@@ -42,22 +38,19 @@ def test_run_swing_writes_the_table(tmp_path: Path) -> None:
 def test_figure_plots_each_class_at_its_lengths_and_rates() -> None:
     table = reference_vessels()
     figure = rate_of_swing_figure(table, fixed_deg_per_m=0.2)
-    try:
-        ax = figure.axes[0]
-        scatters = {c.get_label(): c.get_offsets() for c in ax.collections}
-        assert set(scatters) == set(table["vessel_type"])
-        for vessel_type, rows in table.groupby("vessel_type"):
-            expected = rows[["length_m", "rate_of_swing_deg_per_m"]].to_numpy()
-            np.testing.assert_allclose(np.asarray(scatters[vessel_type]), expected)
-        markers = {c.get_label(): c.get_paths()[0].vertices.shape[0] for c in ax.collections}
-        assert markers["tanker"] != markers["coastguard"]  # square vs triangle, as in the paper
-        colours = [tuple(c.get_facecolor()[0]) for c in ax.collections]
-        assert len(set(colours)) == len(colours)  # no two classes share a colour
-        levels = sorted(line.get_ydata()[0] for line in ax.get_lines())
-        assert levels == [table["rate_of_swing_deg_per_m"].min(), 0.2]
-        figure.canvas.draw()
-    finally:
-        plt.close(figure)
+    ax = figure.axes[0]
+    scatters = {c.get_label(): c.get_offsets() for c in ax.collections}
+    assert set(scatters) == set(table["vessel_type"])
+    for vessel_type, rows in table.groupby("vessel_type"):
+        expected = rows[["length_m", "rate_of_swing_deg_per_m"]].to_numpy()
+        np.testing.assert_allclose(np.asarray(scatters[vessel_type]), expected)
+    markers = {c.get_label(): c.get_paths()[0].vertices.shape[0] for c in ax.collections}
+    assert markers["tanker"] != markers["coastguard"]  # square vs triangle, as in the paper
+    colours = [tuple(c.get_facecolor()[0]) for c in ax.collections]
+    assert len(set(colours)) == len(colours)  # no two classes share a colour
+    levels = sorted(line.get_ydata()[0] for line in ax.get_lines())
+    assert levels == [table["rate_of_swing_deg_per_m"].min(), 0.2]
+    FigureCanvasAgg(figure).draw()
 
 
 def test_swing_command(tmp_path: Path) -> None:

@@ -13,8 +13,13 @@ from pyproj import Geod
 
 from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
-from colregs9_cli.core.replay_params import CourseSource, ReplayParams
-from colregs9_cli.core.tracks import SAMPLE_COLUMNS, TrackStats, build_tracks
+from colregs9_cli.core.tracks import (
+    SAMPLE_COLUMNS,
+    CourseSource,
+    TrackParams,
+    TrackStats,
+    build_tracks,
+)
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.units import MPS_PER_KNOT
 
@@ -58,7 +63,7 @@ def northbound(t_s: list[float], speed_mps: float = 5.0) -> pd.DataFrame:
 
 def test_output_columns_and_sorting() -> None:
     two = pd.concat([northbound([10, 0, 5]), reports([0, 4], [0, 0], [0, 8], mmsi=5, sog_kn=4.0)])
-    tracks = build_tracks(two, FRAME, ReplayParams())
+    tracks = build_tracks(two, FRAME, TrackParams())
     samples = tracks.samples
     assert tuple(samples.columns) == SAMPLE_COLUMNS
     assert samples["mmsi"].tolist() == [5] * 5 + [219000001] * 11
@@ -69,7 +74,7 @@ def test_output_columns_and_sorting() -> None:
 
 def test_gap_longer_than_max_gap_splits_and_leaves_the_gap_empty() -> None:
     times = [*range(0, 101, 10), *range(401, 502, 10)]  # 101 → 401: a 300 s gap, then 301
-    tracks = build_tracks(northbound(times), FRAME, ReplayParams(max_gap_s=299.0))
+    tracks = build_tracks(northbound(times), FRAME, TrackParams(max_gap_s=299.0))
     assert tracks.stats.gap_splits == 1
     assert tracks.stats.segments == 2
     steps = tracks.samples["step"].to_numpy() - T0_S
@@ -80,7 +85,7 @@ def test_gap_longer_than_max_gap_splits_and_leaves_the_gap_empty() -> None:
 
 
 def test_gap_equal_to_max_gap_does_not_split() -> None:
-    tracks = build_tracks(northbound([0, 300, 310]), FRAME, ReplayParams(max_gap_s=300.0))
+    tracks = build_tracks(northbound([0, 300, 310]), FRAME, TrackParams(max_gap_s=300.0))
     assert tracks.stats.gap_splits == 0
     assert tracks.stats.segments == 1
     assert len(tracks.samples) == 311
@@ -91,7 +96,7 @@ def test_isolated_speed_jump_is_dropped_and_counted() -> None:
     frame = northbound([0, 10, 20, 30, 40, 50])
     lat, lon = FRAME.to_geodetic(150.0, 5000.0)
     frame.loc[3, ["lat_deg", "lon_deg"]] = [float(lat), float(lon)]
-    tracks = build_tracks(frame, FRAME, ReplayParams())
+    tracks = build_tracks(frame, FRAME, TrackParams())
     assert tracks.stats.speed_jump_dropped == 1
     assert tracks.stats.jump_splits == 0
     assert tracks.stats.segments == 1
@@ -107,7 +112,7 @@ def test_last_report_jumping_is_dropped() -> None:
     frame = northbound([0, 10, 20])
     lat, lon = FRAME.to_geodetic(100.0, 3000.0)
     frame.loc[2, ["lat_deg", "lon_deg"]] = [float(lat), float(lon)]
-    tracks = build_tracks(frame, FRAME, ReplayParams())
+    tracks = build_tracks(frame, FRAME, TrackParams())
     assert tracks.stats.speed_jump_dropped == 1
     assert tracks.samples["step"].max() == T0_S + 10
 
@@ -117,7 +122,7 @@ def test_confirmed_jump_splits_the_track_without_dropping() -> None:
     t = [0, 10, 20, 30, 40, 50]
     north = [0.0, 50.0, 100.0, 150.0, 200.0, 250.0]
     east = [0.0, 0.0, 0.0, 5000.0, 5000.0, 5000.0]
-    tracks = build_tracks(reports(t, north, east), FRAME, ReplayParams())
+    tracks = build_tracks(reports(t, north, east), FRAME, TrackParams())
     assert tracks.stats.speed_jump_dropped == 0
     assert tracks.stats.jump_splits == 1
     assert tracks.stats.segments == 2
@@ -129,16 +134,16 @@ def test_confirmed_jump_splits_the_track_without_dropping() -> None:
 def test_speed_exactly_at_the_limit_is_plausible() -> None:
     limit_mps = 50.0 * MPS_PER_KNOT
     frame = reports([0, 10], [0.0, 10 * limit_mps], [0.0, 0.0])
-    tracks = build_tracks(frame, FRAME, ReplayParams(max_speed_kn=50.0 * (1 + 1e-9)))
+    tracks = build_tracks(frame, FRAME, TrackParams(max_speed_kn=50.0 * (1 + 1e-9)))
     assert tracks.stats.speed_jump_dropped == 0
-    tracks = build_tracks(frame, FRAME, ReplayParams(max_speed_kn=50.0 * (1 - 1e-6)))
+    tracks = build_tracks(frame, FRAME, TrackParams(max_speed_kn=50.0 * (1 - 1e-6)))
     assert tracks.stats.speed_jump_dropped == 1
 
 
 def test_same_second_reports_keep_the_first() -> None:
     frame = pd.concat([northbound([0, 10, 20]), northbound([10])], ignore_index=True)
     frame.loc[3, "sog_kn"] = 99.0
-    tracks = build_tracks(frame, FRAME, ReplayParams())
+    tracks = build_tracks(frame, FRAME, TrackParams())
     assert tracks.stats.same_time_dropped == 1
     assert tracks.stats.reports_used == 3
     assert (tracks.samples["sog_kn"] < 99.0).all()
@@ -147,7 +152,7 @@ def test_same_second_reports_keep_the_first() -> None:
 def test_positions_and_speed_are_linear_in_time() -> None:
     # Linear on the Earth between reports: in the frame, to a fraction of a millimetre.
     frame = reports([0, 10], [0.0, 100.0], [0.0, -40.0], sog_kn=[4.0, 6.0], cog_deg=350.0)
-    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    samples = build_tracks(frame, FRAME, TrackParams()).samples
     at_3 = samples.loc[samples["step"] == T0_S + 3].iloc[0]
     assert at_3["north_m"] == pytest.approx(30.0, abs=1e-4)
     assert at_3["east_m"] == pytest.approx(-12.0, abs=1e-4)
@@ -160,7 +165,7 @@ def test_positions_and_speed_are_linear_in_time() -> None:
 
 def test_course_interpolates_across_north_along_the_short_arc() -> None:
     frame = reports([0, 10], [0.0, 50.0], [0.0, 0.0], cog_deg=[359.0, 1.0])
-    samples = build_tracks(frame, FRAME, ReplayParams(step_s=0.5)).samples
+    samples = build_tracks(frame, FRAME, TrackParams(step_s=0.5)).samples
     course = dict(zip(samples["t_s"] - T0_S, samples["cog_deg"], strict=True))
     assert course[5.0] == pytest.approx(0.0, abs=1e-9)  # not 180
     assert course[2.5] == pytest.approx(359.5)
@@ -170,14 +175,14 @@ def test_course_interpolates_across_north_along_the_short_arc() -> None:
 
 def test_course_interpolates_the_other_way_too() -> None:
     frame = reports([0, 4], [0.0, 20.0], [0.0, 0.0], cog_deg=[10.0, 350.0])
-    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    samples = build_tracks(frame, FRAME, TrackParams()).samples
     assert samples["cog_deg"].tolist() == pytest.approx([10.0, 5.0, 0.0, 355.0, 350.0])
 
 
 def test_no_extrapolation_and_grid_alignment() -> None:
     # Reports at T0+2 s and T0+23 s; a 5 s grid gives samples at T0+5, 10, 15, 20 only.
     frame = reports([2, 23], [0.0, 210.0], [0.0, 0.0])
-    tracks = build_tracks(frame, FRAME, ReplayParams(step_s=5.0))
+    tracks = build_tracks(frame, FRAME, TrackParams(step_s=5.0))
     samples = tracks.samples
     assert (samples["t_s"] - T0_S).tolist() == [5.0, 10.0, 15.0, 20.0]
     assert samples["step"].tolist() == [(T0_S + s) // 5 for s in (5, 10, 15, 20)]
@@ -188,14 +193,14 @@ def test_no_extrapolation_and_grid_alignment() -> None:
 
 def test_sub_second_report_times_stay_inside_the_segment() -> None:
     frame = reports([0.4, 3.6], [0.0, 32.0], [0.0, 0.0])
-    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    samples = build_tracks(frame, FRAME, TrackParams()).samples
     assert (samples["t_s"] - T0_S).tolist() == pytest.approx([1.0, 2.0, 3.0])
     assert samples["north_m"].tolist() == pytest.approx([6.0, 16.0, 26.0])
 
 
 def test_segment_between_grid_points_has_no_samples() -> None:
     frame = reports([1, 3], [0.0, 10.0], [0.0, 0.0])
-    tracks = build_tracks(frame, FRAME, ReplayParams(step_s=5.0))
+    tracks = build_tracks(frame, FRAME, TrackParams(step_s=5.0))
     assert tracks.samples.empty
     assert tracks.stats.segments == 1
 
@@ -205,7 +210,7 @@ def test_missing_sog_and_cog_come_from_the_movement() -> None:
     t = [0, 10, 20, 30]
     east = [0.0, 50.0, 100.0, 105.0]
     frame = reports(t, [0.0] * 4, east, sog_kn=np.nan, cog_deg=np.nan)
-    samples = build_tracks(frame, FRAME, ReplayParams()).samples.set_index("t_s")
+    samples = build_tracks(frame, FRAME, TrackParams()).samples.set_index("t_s")
     # Central differences: (100 − 0)/20 s at t=10, (105 − 50)/20 s at t=20, one-sided at the ends.
     assert samples.loc[T0_S + 0, "sog_kn"] == pytest.approx(5.0 / MPS_PER_KNOT)
     assert samples.loc[T0_S + 10, "sog_kn"] == pytest.approx(5.0 / MPS_PER_KNOT)
@@ -228,14 +233,14 @@ def test_missing_sog_and_cog_come_from_the_movement() -> None:
 
 def test_a_vessel_that_did_not_move_gets_no_course() -> None:
     frame = reports([0, 10], [0.0, 0.0], [0.0, 0.0], sog_kn=np.nan, cog_deg=np.nan)
-    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    samples = build_tracks(frame, FRAME, TrackParams()).samples
     assert (samples["sog_kn"] == 0.0).all()
     assert samples["cog_deg"].isna().all()
 
 
 def test_reported_sog_and_cog_are_kept() -> None:
     frame = reports([0, 10], [0.0, 50.0], [0.0, 0.0], sog_kn=3.0, cog_deg=10.0)
-    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    samples = build_tracks(frame, FRAME, TrackParams()).samples
     assert samples["sog_kn"].to_numpy() == pytest.approx(3.0)
     assert samples["cog_deg"].to_numpy() == pytest.approx(10.0)
 
@@ -243,8 +248,8 @@ def test_reported_sog_and_cog_are_kept() -> None:
 def test_course_source_heading_falls_back_to_cog() -> None:
     frame = reports([0, 10, 20], [0.0, 50.0, 100.0], [0.0] * 3, cog_deg=0.0)
     frame["heading_deg"] = [20.0, np.nan, 20.0]
-    by_cog = build_tracks(frame, FRAME, ReplayParams()).samples
-    by_heading = build_tracks(frame, FRAME, ReplayParams(), CourseSource.HEADING).samples
+    by_cog = build_tracks(frame, FRAME, TrackParams()).samples
+    by_heading = build_tracks(frame, FRAME, TrackParams(), CourseSource.HEADING).samples
     assert by_cog["course_deg"].to_numpy() == pytest.approx(0.0)
     # Heading 20 at t=0, null → COG 0 at t=10, 20 at t=20.
     expected = [20.0 - 2.0 * k for k in range(11)] + [2.0 * k for k in range(1, 11)]
@@ -256,7 +261,7 @@ def test_course_source_heading_falls_back_to_cog() -> None:
 def test_nav_status_is_held_from_the_latest_report() -> None:
     frame = northbound([0, 10, 20])
     frame["nav_status"] = [0.0, 3.0, np.nan]
-    samples = build_tracks(frame, FRAME, ReplayParams()).samples
+    samples = build_tracks(frame, FRAME, TrackParams()).samples
     status = samples["nav_status"].tolist()
     assert status[:10] == [0] * 10
     assert status[10:20] == [3] * 10
@@ -269,7 +274,7 @@ def test_vessels_hold_the_last_known_static_values() -> None:
     frame["draught_m"] = [5.0, 6.5, np.nan]
     frame["name"] = [None, "HAMLET", None]
     other = reports([0, 10], [900.0, 900.0], [0.0, 50.0], mmsi=7)
-    tracks = build_tracks(pd.concat([frame, other], ignore_index=True), FRAME, ReplayParams())
+    tracks = build_tracks(pd.concat([frame, other], ignore_index=True), FRAME, TrackParams())
     vessels = tracks.vessels
     assert vessels.index.tolist() == [7, 219000001]
     assert vessels.loc[219000001, "length_m"] == 100.0
@@ -281,10 +286,10 @@ def test_vessels_hold_the_last_known_static_values() -> None:
 def test_unclean_input_is_a_programming_error() -> None:
     frame = northbound([0, 10])
     with pytest.raises(ValueError, match="canonical columns"):
-        build_tracks(frame.drop(columns="cog_deg"), FRAME, ReplayParams())
+        build_tracks(frame.drop(columns="cog_deg"), FRAME, TrackParams())
     frame.loc[1, "lat_deg"] = np.nan
     with pytest.raises(ValueError, match="cleaned"):
-        build_tracks(frame, FRAME, ReplayParams())
+        build_tracks(frame, FRAME, TrackParams())
 
 
 @pytest.mark.slow
@@ -299,7 +304,7 @@ def test_real_nmea_sample(fixtures_dir: Path) -> None:
         positions["lon_deg"].min(),
         positions["lon_deg"].max(),
     )
-    tracks = build_tracks(positions, frame, ReplayParams())
+    tracks = build_tracks(positions, frame, TrackParams())
     # With the $PGHP milliseconds no (mmsi, timestamp) repeats (floored to the second, 53
     # did). The longest gap between a vessel's reports is 258 s (< 300, no gap split). Four
     # reports imply > 50 kn from the last kept one and are dropped: with whole seconds it was
@@ -309,7 +314,7 @@ def test_real_nmea_sample(fixtures_dir: Path) -> None:
     # grid second has no sample: 1,112 of the 1,438 vessels have samples. Of their 282,777
     # samples, 117,411 are under way (SOG >= 0.5 kn), the ones the pair search uses.
     assert len(tracks.samples) == 282777
-    under_way = tracks.samples["sog_kn"] >= ReplayParams().min_sog_kn
+    under_way = tracks.samples["sog_kn"] >= TrackParams().min_sog_kn
     assert tracks.stats.samples == int(under_way.sum())
     assert tracks.stats == TrackStats(
         reports_in=24688,
@@ -354,7 +359,7 @@ def test_grid_courses_far_from_the_central_meridian() -> None:
             "nav_status": 0,
         }
     )
-    samples = build_tracks(positions, frame, ReplayParams(), CourseSource.HEADING).samples
+    samples = build_tracks(positions, frame, TrackParams(), CourseSource.HEADING).samples
     by_time = samples.set_index("t_s")
     # The derived COG is true: the ellipsoidal azimuth from the previous to the next report.
     azimuth_deg, _, _ = geod.inv(lon[9], lat[9], lon[11], lat[11])
@@ -378,7 +383,7 @@ def test_a_track_across_the_antimeridian_is_resampled_on_the_earth() -> None:
     crossing["lat_deg"] = [0.0, 0.0]
     crossing["lon_deg"] = [179.9998, -179.9998]
     far_frame = LocalFrame(0.0, 10.0)
-    samples = build_tracks(crossing, far_frame, ReplayParams()).samples
+    samples = build_tracks(crossing, far_frame, TrackParams()).samples
     middle = samples.loc[samples["step"] == T0_S + 5].iloc[0]
     assert abs(middle["lon_deg"]) == pytest.approx(180.0, abs=1e-9)
     assert middle["lat_deg"] == pytest.approx(0.0, abs=1e-12)

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from colregs9_cli.core.replay_params import ReplayParams
 from colregs9_cli.core.vessel_defaults import DIMENSIONS, default_table, vessel_dimensions
+from colregs9_cli.jobs.replay_params import ReplayParams
 
 
 def test_reported_dimensions_are_kept() -> None:
@@ -48,7 +48,7 @@ def test_only_missing_dimensions_are_defaulted_and_named() -> None:
 
 
 def test_query_overrides_replace_the_table() -> None:
-    overrides = ReplayParams(default_draught_m=4.5).dimension_overrides
+    overrides = ReplayParams(default_draught_m=4.5).dimension_defaults
     dims = vessel_dimensions({"mobile_type": "Class B", "length_m": 10.0}, overrides)
     assert (dims.length_m, dims.breadth_m, dims.draught_m) == (10.0, 4.0, 4.5)
     assert "override" in dims.basis

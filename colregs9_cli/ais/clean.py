@@ -1,6 +1,6 @@
 """Cleaning helpers shared by the readers: text to numbers, sentinels to nulls, code tables.
 
-"Not available" becomes null (DESIGN §4): latitude outside ±90 (91), longitude outside ±180
+"Not available" becomes null (docs/design.md §4): latitude outside ±90 (91), longitude outside ±180
 (181), SOG 102.3 and above, COG 360 and above, heading 360 and above (511), a rate of turn
 beyond ±720 deg/min (the sentinel -128 decoded), dimension 0 or less, draught 0 or less, a
 dimension beyond what ships have or not finite (``MAX_LENGTH_M`` ...; counted as
@@ -20,13 +20,18 @@ import pyarrow as pa
 import pyarrow.compute as pc
 from numpy.typing import NDArray
 
-from .schema import VESSEL_MOBILE_TYPES
+from ..vessels import (
+    MAX_BREADTH_M,
+    MAX_DRAUGHT_M,
+    MAX_LENGTH_M,
+    MMSI_MAX,
+    MMSI_MIN,
+    VESSEL_MOBILE_TYPES,
+)
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 
-MMSI_MIN = 201_000_000  # MID 201: the lowest allocated maritime identification digits
-MMSI_MAX = 775_999_999  # MID 775
 MAX_ROT_DEG_PER_MIN = 720.0
 _NUMBER = r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$"
 _NULL_TEXTS = ["", "unknown", "undefined", "unknown value", "not available", "n/a"]
@@ -164,7 +169,7 @@ def to_float(values: pa.Array | pa.ChunkedArray) -> tuple[pa.Array, BoolArray]:
 
 
 def to_numpy_float(values: pa.Array | pa.ChunkedArray) -> FloatArray:
-    """Nulls as NaN (filling first is about twice as fast as letting to_numpy do it)."""
+    """Nulls as NaN (filling first is faster than letting to_numpy do it)."""
     if values.null_count:
         values = pc.fill_null(values, pa.scalar(np.nan, pa.float64()))
     return np.asarray(values.to_numpy(zero_copy_only=False), dtype=np.float64)
@@ -248,14 +253,7 @@ def is_vessel(mobile_type: pa.Array) -> BoolArray:
 
 Dimensions = tuple[FloatArray, FloatArray, FloatArray]
 
-# The largest dimensions a ship has (metres): the longest ships are under 460 m, the widest
-# under 70 m, and AIS encodes a draught of at most 25.5 m. Beyond these, or not finite, a
-# value is a corrupt field (``inf``, ``1e400``): it is dropped (NaN, as not available), never
-# used in a statistic, and counted in the ledger as ``implausible_dimension``
-# (``DimensionColumns.implausible``).
-MAX_LENGTH_M = 500.0
-MAX_BREADTH_M = 80.0
-MAX_DRAUGHT_M = 30.0
+# The largest dimensions a ship has: ``vessels.MAX_LENGTH_M`` and the others.
 _LIMITS_M = (MAX_LENGTH_M, MAX_BREADTH_M, MAX_DRAUGHT_M)
 
 

@@ -1,9 +1,10 @@
 """Column maps: what the columns of a CSV mean, for layouts other than DMA's.
 
-A map names, for each source column, the canonical column it fills (DESIGN §4), and says how
+A map names, for each source column, the canonical column it fills (docs/design.md §4), and says how
 its values are written: the time format, the units, the values that mean "not available".
-The MarineCadastre layouts and exactEarth/Spire's are built-in maps (``BUILTIN_MAPS``); any
-other CSV is read with a map from a TOML file (``--columns MAP.toml``, ``load_column_map``)::
+The MarineCadastre layouts and exactEarth/Spire's are built-in maps (``BUILTIN_MAPS``, made
+from their entries in layouts.py); any other CSV is read with a map from a TOML file
+(``--columns MAP.toml``, ``load_column_map``)::
 
     name = "aishub"                 # the layout's name in run.json; default: the file's stem
     delimiter = ","                 # one character; default ","
@@ -42,9 +43,9 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ParameterError
+from .layouts import LAYOUTS, MAP_PREFIX, Layout
 from .schema import CANONICAL_COLUMNS
 
-MAP_PREFIX = "columns:"
 TIME_UNIX = "unix"
 TIME_UNIX_MS = "unix_ms"
 
@@ -79,7 +80,7 @@ UNITS: dict[str, dict[str, float]] = {
 class ColumnMap:
     """A CSV layout described column by column (module docstring).
 
-    ``columns``: canonical target -> source column (lower case, as ``detect.normalise_column``
+    ``columns``: canonical target -> source column (lower case, as ``layouts.normalise_column``
     gives). ``units``: target -> factor to the canonical unit (1 where not given).
     ``sentinels``: target -> values, as written, that mean "not available".
     """
@@ -92,7 +93,6 @@ class ColumnMap:
     rot_ais: bool = False
     sentinels: Mapping[str, tuple[float | str, ...]] = field(default_factory=dict)
     source: Path | None = None
-    header: tuple[str, ...] = ()  # the file's columns in order, for a header-less file
     # target -> other names its column goes by (built-in maps): used where the first is absent
     aliases: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
@@ -106,13 +106,6 @@ class ColumnMap:
                 if found:
                     columns[target] = found[0]
         return replace(self, columns=columns, aliases={})
-
-    def missing(self, names: tuple[str, ...]) -> list[str]:
-        """The map's columns that the header ``names`` lacks, in the layout's order."""
-        present = set(names)
-        order = {c: i for i, c in enumerate(self.header)}
-        absent = [c for c in self.read_columns if c not in present]
-        return sorted(absent, key=lambda c: order.get(c, len(order)))
 
     def has(self, target: str) -> bool:
         return target in self.columns
@@ -146,200 +139,29 @@ class ColumnMap:
 
 # -- built-in maps ------------------------------------------------------------------------------
 
-_MARINECADASTRE_TARGETS = {
-    "mmsi": "mmsi",
-    "basedatetime": "timestamp",
-    "lat": "lat_deg",
-    "lon": "lon_deg",
-    "sog": "sog_kn",
-    "cog": "cog_deg",
-    "heading": "heading_deg",
-    "vesselname": "name",
-    "imo": "imo",
-    "callsign": "callsign",
-    "vesseltype": "ship_type",
-    "status": "nav_status",
-    "length": "length_m",
-    "width": "breadth_m",
-    "draft": "draught_m",
-}
-MARINECADASTRE_2015_HEADER = (
-    "mmsi",
-    "basedatetime",
-    "lat",
-    "lon",
-    "sog",
-    "cog",
-    "heading",
-    "vesselname",
-    "imo",
-    "callsign",
-    "vesseltype",
-    "status",
-    "length",
-    "width",
-    "draft",
-    "cargo",
-)
-MARINECADASTRE_HEADER = (*MARINECADASTRE_2015_HEADER, "transceiverclass")
-MARINECADASTRE_2025_HEADER = (
-    "mmsi",
-    "base_date_time",
-    "longitude",
-    "latitude",
-    "sog",
-    "cog",
-    "heading",
-    "vessel_name",
-    "imo",
-    "call_sign",
-    "vessel_type",
-    "status",
-    "length",
-    "width",
-    "draft",
-    "cargo",
-    "transceiver",
-)
-_MARINECADASTRE_2025_TARGETS = {
-    "mmsi": "mmsi",
-    "base_date_time": "timestamp",
-    "longitude": "lon_deg",
-    "latitude": "lat_deg",
-    "sog": "sog_kn",
-    "cog": "cog_deg",
-    "heading": "heading_deg",
-    "vessel_name": "name",
-    "imo": "imo",
-    "call_sign": "callsign",
-    "vessel_type": "ship_type",
-    "status": "nav_status",
-    "length": "length_m",
-    "width": "breadth_m",
-    "draft": "draught_m",
-    "transceiver": "mobile_type",
-}
-# exactEarth / Spire decoded-message CSV, as AISdb documents it: the first columns, up to
-# those read (the file has about 150; a header-less file is not accepted without them all).
-EXACTEARTH_HEADER = (
-    "mmsi",
-    "message_id",
-    "repeat_indicator",
-    "time",
-    "millisecond",
-    "region",
-    "country",
-    "base_station",
-    "online_data",
-    "group_code",
-    "sequence_id",
-    "channel",
-    "data_length",
-    "vessel_name",
-    "call_sign",
-    "imo",
-    "ship_type",
-    "dimension_to_bow",
-    "dimension_to_stern",
-    "dimension_to_port",
-    "dimension_to_starboard",
-    "draught",
-    "destination",
-    "ais_version",
-    "navigational_status",
-    "rot",
-    "sog",
-    "accuracy",
-    "longitude",
-    "latitude",
-    "cog",
-    "heading",
-)
-_EXACTEARTH_TARGETS = {
-    "mmsi": "mmsi",
-    "message_id": "message_type",
-    "time": "timestamp",
-    "millisecond": "millisecond",
-    "vessel_name": "name",
-    "call_sign": "callsign",
-    "imo": "imo",
-    "ship_type": "ship_type",
-    "dimension_to_bow": "to_bow",
-    "dimension_to_stern": "to_stern",
-    "dimension_to_port": "to_port",
-    "dimension_to_starboard": "to_starboard",
-    "draught": "draught_m",
-    "navigational_status": "nav_status",
-    "rot": "rot_deg_per_min",
-    "sog": "sog_kn",
-    "longitude": "lon_deg",
-    "latitude": "lat_deg",
-    "cog": "cog_deg",
-    "heading": "heading_deg",
-}
+
+def _builtin(layout: Layout) -> ColumnMap:
+    """The ``ColumnMap`` of a layout read through a built-in map (layouts.py)."""
+    assert layout.column_map is not None, "a layout with a built-in map"
+    spec = layout.column_map
+    columns = {target: source for source, target in spec.targets.items()}
+    return ColumnMap(layout.name, columns, spec.time_format, aliases=spec.aliases)
 
 
-def _builtin(
-    name: str,
-    targets: Mapping[str, str],
-    header: tuple[str, ...],
-    time_format: str,
-    aliases: Mapping[str, tuple[str, ...]] | None = None,
-) -> ColumnMap:
-    columns = {target: source for source, target in targets.items()}
-    return ColumnMap(name, columns, time_format, header=header, aliases=aliases or {})
-
-
-ISO_TIME_FORMAT = "%Y-%m-%dT%H:%M:%S"  # a space for the T is accepted too (mapped.py)
 BUILTIN_MAPS: dict[str, ColumnMap] = {
-    "marinecadastre": _builtin(
-        "marinecadastre",
-        {**_MARINECADASTRE_TARGETS, "transceiverclass": "mobile_type"},
-        MARINECADASTRE_HEADER,
-        ISO_TIME_FORMAT,
-    ),
-    "marinecadastre2015": _builtin(
-        "marinecadastre2015", _MARINECADASTRE_TARGETS, MARINECADASTRE_2015_HEADER, ISO_TIME_FORMAT
-    ),
-    "marinecadastre2025": _builtin(
-        "marinecadastre2025",
-        _MARINECADASTRE_2025_TARGETS,
-        MARINECADASTRE_2025_HEADER,
-        ISO_TIME_FORMAT,
-    ),
-    # Spire's files call the heading True_heading, AISdb's Heading.
-    "exactearth": _builtin(
-        "exactearth",
-        _EXACTEARTH_TARGETS,
-        EXACTEARTH_HEADER,
-        "%Y%m%d_%H%M%S",
-        {"heading_deg": ("true_heading",)},
-    ),
+    layout.name: _builtin(layout) for layout in LAYOUTS.values() if layout.column_map is not None
 }
-
-
-def builtin_for_header(names: set[str]) -> str | None:
-    """The built-in map whose columns a header holds (normalised names), if any."""
-    if {"mmsi", "basedatetime", "lat", "lon"} <= names:
-        return "marinecadastre" if "transceiverclass" in names else "marinecadastre2015"
-    if {"mmsi", "base_date_time", "latitude", "longitude"} <= names:
-        return "marinecadastre2025"
-    if {"mmsi", "message_id", "time", "millisecond", "latitude", "longitude"} <= names:
-        return "exactearth"
-    return None
 
 
 # -- maps from TOML -----------------------------------------------------------------------------
 
 
-def column_map(layout: str) -> ColumnMap | None:
-    """The map of a CSV layout name: built-in, or ``columns:<path>`` (a TOML map); None for
+def column_map(layout: Layout) -> ColumnMap | None:
+    """The map of a layout: built-in, or a ``--columns`` map (read from its TOML); None for
     the layouts read otherwise (DMA, NMEA, Parquet)."""
-    if layout in BUILTIN_MAPS:
-        return BUILTIN_MAPS[layout]
-    if layout.startswith(MAP_PREFIX):
-        return load_column_map(Path(layout[len(MAP_PREFIX) :]))
-    return None
+    if layout.map_file is not None:
+        return load_column_map(layout.map_file)
+    return BUILTIN_MAPS.get(layout.name)
 
 
 def map_layout(path: Path) -> str:

@@ -1,5 +1,6 @@
-"""The columns each CSV layout reads, and how they are read (DMA here; the others by their
-column maps, column_map.py).
+"""The columns a CSV layout reads, and how they are read: a DMA layout's are fixed
+(``Layout.csv_columns``, layouts.py); the others' follow their column map (column_map.py) as
+resolved for the file's header.
 
 A light module (no ``pyarrow.compute``, pandas or shapely): ``colregs9 stats`` starts reading
 its first CSV before it imports those (``csv_read.start_reading``).
@@ -7,94 +8,23 @@ its first CSV before it imports those (``csv_read.start_reading``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from .column_map import ColumnMap, column_map
-from .detect import DMA22_COLUMNS
-
-# -- DMA "aisdk" (lower-case names) -------------------------------------------------------------
-
-# Header columns the canonical schema has no place for: the CSV reader skips them.
-DMA_UNREAD_COLUMNS = (
-    "cargo type",
-    "type of position fixing device",
-    "destination",
-    "eta",
-    "data source type",
-)
-DMA_READ_COLUMNS = tuple(c for c in DMA22_COLUMNS if c not in DMA_UNREAD_COLUMNS)
-DMA_ABCD = ("a", "b", "c", "d")
-# Columns read as numbers; a chunk with text in one of them is parsed again with every
-# column as text (see csv_chunks.py).
-DMA_NUMERIC_COLUMNS = (
-    "mmsi",
-    "latitude",
-    "longitude",
-    "rot",
-    "sog",
-    "cog",
-    "heading",
-    "width",
-    "length",
-    "draught",
-    *DMA_ABCD,
-)
-# Of those, the ones DMA writes as whole numbers (metres), read as integers: about 5 % faster
-# to parse than decimals. A decimal in one makes its chunk text, as any other bad number.
-DMA_WHOLE_COLUMNS = ("mmsi", "width", "length", *DMA_ABCD)
-DMA_STATIC_TEXT_COLUMNS = ("ship type", "name", "callsign", "imo")
-# Converted for every row; the others only for the rows kept.
-DMA_ROW_COLUMNS = ("type of mobile", "mmsi", "latitude", "longitude", "width", "length", "draught")
+from .layouts import CsvColumns, Layout
 
 
-def dma_read_columns(has_abcd: bool) -> tuple[str, ...]:
-    return (*DMA_READ_COLUMNS, *DMA_ABCD) if has_abcd else DMA_READ_COLUMNS
-
-
-def dma_row_columns(has_abcd: bool) -> tuple[str, ...]:
-    return (*DMA_ROW_COLUMNS, *DMA_ABCD) if has_abcd else DMA_ROW_COLUMNS
-
-
-def dma_dimension_columns(has_abcd: bool) -> tuple[str, ...]:
-    dimensions = ("width", "length", "draught")
-    return (*dimensions, *DMA_ABCD) if has_abcd else dimensions
-
-
-@dataclass(frozen=True)
-class CsvColumns:
-    """What the chunk reader converts: ``row_columns`` for every row, ``columns`` for the
-    rows taken; ``numeric`` are read as numbers, those also in ``whole`` as integers."""
-
-    columns: tuple[str, ...]
-    row_columns: tuple[str, ...]
-    numeric: tuple[str, ...]
-    whole: tuple[str, ...]
-    delimiter: str = ","
-
-
-def csv_columns(layout: str, header: tuple[str, ...] = ()) -> CsvColumns:
+def csv_columns(layout: Layout, header: tuple[str, ...] = ()) -> CsvColumns:
     """The columns of ``layout`` read from a file with the columns ``header``."""
-    if layout in ("dma26", "dma22"):
-        abcd = layout == "dma26"
-
-        def present(names: tuple[str, ...]) -> tuple[str, ...]:
-            return tuple(c for c in names if abcd or c not in DMA_ABCD)
-
-        return CsvColumns(
-            dma_read_columns(abcd),
-            dma_row_columns(abcd),
-            present(DMA_NUMERIC_COLUMNS),
-            present(DMA_WHOLE_COLUMNS),
-        )
+    if layout.csv_columns is not None:
+        return layout.csv_columns
     return map_columns(file_map(layout, header))
 
 
-def file_map(layout: str, header: tuple[str, ...]) -> ColumnMap:
+def file_map(layout: Layout, header: tuple[str, ...]) -> ColumnMap:
     """The column map of ``layout`` for a file with the columns ``header`` (its aliases
     resolved, column_map.py)."""
     map_ = column_map(layout)
     if map_ is None:
-        raise ValueError(f"{layout!r} is not a mapped CSV layout")
+        raise ValueError(f"{layout.name!r} is not a mapped CSV layout")
     return map_.for_header(header)
 
 
@@ -108,3 +38,12 @@ def map_columns(map_: ColumnMap) -> CsvColumns:
         map_.whole_columns,
         map_.delimiter,
     )
+
+
+def missing_columns(layout: Layout, header: tuple[str, ...]) -> list[str]:
+    """The columns the layout reads that the file's ``header`` lacks, in the layout's order
+    (``Layout.header``; a ``--columns`` map's: the order of its targets)."""
+    present = set(header)
+    order = {c: i for i, c in enumerate(layout.header)}
+    absent = [c for c in csv_columns(layout, header).columns if c not in present]
+    return sorted(absent, key=lambda c: order.get(c, len(order)))

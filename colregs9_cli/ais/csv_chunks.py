@@ -302,8 +302,9 @@ def read_chunks(
 
 def parse_workers() -> int:
     """How many chunks are parsed at once, each on one thread: pyarrow's threads (a 16 MB
-    chunk splits into 4 blocks), up to 4. Chunks side by side cost about 10 % less CPU than
-    one chunk at a time on all threads, which splits and merges its blocks."""
+    chunk splits into 4 blocks), up to 4. Chunks side by side cost less CPU than one chunk at
+    a time on all threads, which splits and merges its blocks (figures:
+    tests/benchmarks/README.md, "Figures moved from code comments")."""
     return max(1, min(CHUNK_BYTES // PARSE_BLOCK_BYTES, pa.cpu_count()))
 
 

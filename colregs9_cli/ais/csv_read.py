@@ -20,16 +20,16 @@ from types import TracebackType
 
 from ..errors import Colregs9Error
 from ..progress import ProgressSink
-from .columns import csv_columns, file_map
+from .columns import csv_columns, missing_columns
 from .csv_chunks import CsvChunk, read_chunks
-from .detect import CsvHeader, csv_header, detect_layout, is_csv_layout
+from .detect import CsvHeader, csv_header, detect_layout
+from .layouts import Layout, find_layout
 from .sources import OpenedData, Source, inspect_source, open_data, read_head
 
 # How many parsed chunks may wait for the caller (about 25 MB each, bytes and row columns).
 # The imports of ``colregs9 stats`` take about as long as parsing 12 chunks on the other
-# core; with fewer the read-ahead stops and a core idles (4: 3.48 s best, 3.56 s median,
-# against 3.39 s and 3.50 s for 12, on 5 M rows). Peak RSS 480 against 675 MB, 550 MB for 6,
-# which measured alike with chunks parsed side by side (1.41 and 1.45 × polars, 8 rounds).
+# core; with fewer the read-ahead stops and a core idles. Each chunk waiting holds memory
+# (figures: tests/benchmarks/README.md, "Figures moved from code comments").
 AHEAD_CHUNKS = 12
 _POLL_S = 0.05
 
@@ -79,7 +79,7 @@ class CsvReading:
     def __init__(
         self,
         source: Source,
-        layout: str,
+        layout: Layout,
         header: CsvHeader,
         progress: ProgressSink | None,
         ahead: bool = False,
@@ -174,13 +174,6 @@ class CsvReading:
         return self._exits.__exit__(kind, error, trace)
 
 
-def missing_columns(layout: str, header: CsvHeader) -> list[str]:
-    """The columns the layout reads that the header lacks, in the layout's order."""
-    if layout in ("dma26", "dma22"):
-        return [c for c in csv_columns(layout).columns if c not in header.columns]
-    return file_map(layout, header.columns).missing(header.columns)
-
-
 @contextlib.contextmanager
 def start_reading(paths: Sequence[Path], fmt: str | None) -> Iterator[CsvReading | None]:
     """Start reading the first input ahead, if it is a CSV that looks readable; else None,
@@ -190,9 +183,9 @@ def start_reading(paths: Sequence[Path], fmt: str | None) -> Iterator[CsvReading
         source = inspect_source(paths[0]) if paths else None
         if source is not None:
             head = read_head(source)
-            layout = fmt if fmt is not None else detect_layout(source, head)
-            header = csv_header(source, head, layout) if is_csv_layout(layout) else None
-            if header is not None and not missing_columns(layout, header):
+            layout = find_layout(fmt) if fmt is not None else detect_layout(source, head)
+            header = csv_header(source, head, layout) if layout.read_as.is_csv else None
+            if header is not None and not missing_columns(layout, header.columns):
                 reading = CsvReading(source, layout, header, None, ahead=True)
     if reading is None:
         yield None

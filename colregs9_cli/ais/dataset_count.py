@@ -18,6 +18,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from ..query import Query
+from ..vessels import DIMENSIONS
 from .counting import RowCounts, sum_by
 from .dataset_scan import (
     Dataset,
@@ -26,7 +27,7 @@ from .dataset_scan import (
     reports_filter,
     scan_columns,
 )
-from .schema import CANONICAL_COLUMNS, DIMENSIONS, STATS_POSITION_COLUMNS, canonical_fields
+from .schema import CANONICAL_COLUMNS, STATS_POSITION_COLUMNS, canonical_fields
 
 REPORT_COLUMNS: tuple[str, ...] = ("mmsi", *DIMENSIONS)
 # The flag of the rows with a position, in a query of everything.

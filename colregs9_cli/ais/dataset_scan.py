@@ -42,8 +42,9 @@ DATASET_SCHEMA = CANONICAL_SCHEMA.append(PARTITION_FIELD)
 _PARTITIONING = ds.HivePartitioning(pa.schema([PARTITION_FIELD]), null_fallback=UNDATED)
 _EPOCH = datetime(1970, 1, 1, tzinfo=UTC)
 _REMEDY = "re-create the dataset with colregs9 ingest"
-# A scan reads ahead this many batches of one file at a time: on the 24 h benchmark day,
-# pyarrow's default (16 batches of 4 files) held 2.7 times the memory and was no faster.
+# A scan reads ahead this many batches of one file at a time: pyarrow's default (16 batches of
+# 4 files) held much more memory and was no faster (tests/benchmarks/README.md, "Figures
+# moved from code comments").
 _BATCH_READAHEAD = 4
 _FRAGMENT_READAHEAD = 1
 

@@ -40,11 +40,16 @@ from .clean import (
     positive_or_nan,
     whole_positive,
 )
-from .columns import DMA_ABCD, DMA_STATIC_TEXT_COLUMNS, dma_dimension_columns
+from .layouts import DMA_ABCD, DMA_TIME_FORMAT
 from .schema import CANONICAL_SCHEMA
 
-DMA_TIME_FORMAT = "%d/%m/%Y %H:%M:%S"
+_STATIC_TEXT_COLUMNS = ("ship type", "name", "callsign", "imo")
 _DMA_DAY_AND_SECOND = r"^(?P<day>\d{1,2})/\d{1,2}/\d{4}\s+\d{1,2}:\d{1,2}:(?P<second>\d{1,2})$"
+
+
+def _dimension_columns(has_abcd: bool) -> tuple[str, ...]:
+    dimensions = ("width", "length", "draught")
+    return (*dimensions, *DMA_ABCD) if has_abcd else dimensions
 
 
 def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
@@ -64,7 +69,7 @@ def dma_fields(batch: pa.RecordBatch, has_abcd: bool) -> Fields:
     lat, bad_lat = float_column(batch.column("latitude"))
     lon, bad_lon = float_column(batch.column("longitude"))
     unparseable, problem = number_problems(bad_mmsi, bad_lat, bad_lon)
-    dimensions = batch.select(list(dma_dimension_columns(has_abcd)))
+    dimensions = batch.select(list(_dimension_columns(has_abcd)))
     return Fields(
         mmsi=mmsi,
         lat_deg=null_outside(lat, -90.0, 90.0),
@@ -88,7 +93,7 @@ def _is_vessel(mobile_type: pa.Array) -> BoolArray:
 def dma_static_text(batch: pa.RecordBatch) -> BoolArray:
     """Rows that carry a ship type, name, call sign or IMO."""
     present = np.zeros(batch.num_rows, dtype=bool)
-    for column in DMA_STATIC_TEXT_COLUMNS:
+    for column in _STATIC_TEXT_COLUMNS:
         valid = pc.is_valid(clean_text(batch.column(column)))
         present |= np.asarray(valid.to_numpy(zero_copy_only=False), dtype=bool)
     return present

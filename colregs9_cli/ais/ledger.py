@@ -8,6 +8,10 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
 
+# The longest reject example quoted: a malformed line's text, and the first example of an
+# error that names one.
+EXAMPLE_CHARS = 300
+
 
 class RejectReason(StrEnum):
     UNPARSEABLE = "unparseable"
@@ -35,7 +39,7 @@ class RejectsLedger:
     they are not rejects, but they are counted so that nothing disappears unaccounted.
 
     ``dropped`` counts rows read that kept their place but lost a value, by reason: a
-    dimension beyond what ships have (``ais.clean.MAX_LENGTH_M`` ...) or not finite is
+    dimension beyond what ships have (``vessels.MAX_LENGTH_M`` ...) or not finite is
     dropped as ``implausible_dimension``: the row's position is good, its dimension goes into
     no statistic. These are not in the balance (the row is used, outside or rejected).
     """

@@ -51,7 +51,8 @@ from .clean import (
     positive_or_nan,
     whole_positive,
 )
-from .column_map import ISO_TIME_FORMAT, PART_TARGETS, TIME_UNIX, TIME_UNIX_MS, ColumnMap
+from .column_map import PART_TARGETS, TIME_UNIX, TIME_UNIX_MS, ColumnMap
+from .layouts import ISO_TIME_FORMAT
 from .marinecadastre import ship_type_text
 from .schema import CANONICAL_SCHEMA
 

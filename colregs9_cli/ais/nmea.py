@@ -59,7 +59,7 @@ COG and heading 360 and above (360, 511; type 27: 511), rate of turn -128 and ±
 fast with no turn indicator: no rate is known), dimension 0, draught 0, ship type 0, IMO 0,
 empty text. The rate of turn is (raw / 4.733)² deg/min with the sign of raw. Type 27 (the
 long-range broadcast of SOLAS ships) is "Class A". A length (A+B) or breadth (C+D) beyond
-what ships have (``clean.MAX_LENGTH_M``, ``MAX_BREADTH_M``) is dropped too, and its message
+what ships have (``vessels.MAX_LENGTH_M``, ``MAX_BREADTH_M``) is dropped too, and its message
 (with a valid MMSI) counted in the ledger as ``implausible_dimension`` (AIS cannot encode a
 draught beyond ``MAX_DRAUGHT_M``).
 """
@@ -91,10 +91,9 @@ from pyais.messages import (
     TagBlock,
 )
 
+from ..vessels import MAX_BREADTH_M, MAX_LENGTH_M
 from .batch import STATIC_SCHEMA, AisBatch
 from .clean import (
-    MAX_BREADTH_M,
-    MAX_LENGTH_M,
     SHIP_TYPE_CATEGORIES,
     implausible,
     implausible_text,

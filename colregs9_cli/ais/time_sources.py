@@ -6,8 +6,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import TYPE_CHECKING
 
 from ..errors import ParameterError
+
+if TYPE_CHECKING:
+    from ..query import Query
 
 
 class TimeSource(StrEnum):
@@ -46,3 +50,11 @@ class IngestParams:
                 "at most once, at least one, in order of precedence"
             )
         object.__setattr__(self, "nmea_time_sources", tuple(TimeSource(n) for n in names))
+
+
+def ingest_params(query: Query) -> IngestParams:
+    """The query's ``[ingest]`` table, checked (``ParameterError`` naming the file)."""
+    from ..config import dataclass_from_table
+
+    where = f"{query.source if query.source is not None else 'query'} [ingest]"
+    return dataclass_from_table(IngestParams, dict(query.tables.get("ingest", {})), where)

@@ -4,7 +4,7 @@ GDAL reads a cell cut short between two records without a word, with the feature
 missing records gone: a cell whose download stopped at 90 % of its records read as 52 of its
 249 depth areas, all of them shallow. Each record's leader starts with the record's length in
 five digits, and the cell's DSSI field lists how many records of each kind it holds, which
-together tell such a cell (``chart.s57_cell_info`` compares them).
+together tell such a cell (``cells.s57_cell_info`` compares them).
 """
 
 from __future__ import annotations

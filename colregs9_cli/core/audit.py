@@ -1,4 +1,4 @@
-"""Audit facts beyond the paper (DESIGN §5 Replay): did the pair pass within the data, how
+"""Audit facts beyond the paper (docs/design.md §5 Replay): did the pair pass within the data, how
 close, and what each vessel did before the closest approach.
 
 Every function works on one pair's steps from the trigger on (row 0 is the trigger), both

@@ -1,5 +1,5 @@
 """COLREGs rules 13–15: one situation per pair and both vessels' roles (the paper's G_a,
-DESIGN §5).
+docs/design.md §5).
 
 Angles: β is the relative bearing of the target from own ship and β' that of own ship from
 the target, each measured clockwise from the observer's course, in [0, 360). The course is
@@ -49,10 +49,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..config import dataclass_from_table
 from ..errors import ParameterError
-from ..geo import course_in_tangent_plane
+from ..geo import course_in_tangent_plane, velocity_mps
 from ..units import MPS_PER_KNOT, wrap_deg
-from .encounters import velocity_mps
-from .replay_params import CourseSource
+from .tracks import CourseSource
 
 
 class Situation(StrEnum):

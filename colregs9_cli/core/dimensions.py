@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ..ais.schema import DIMENSIONS
+from ..vessels import DIMENSIONS
 
 STAT_COLUMNS: tuple[str, ...] = ("count", "mean", "median", "std", "min", "max")
 # Vessels whose ship type is never reported are grouped under this label with ``--by``.

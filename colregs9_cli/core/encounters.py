@@ -1,4 +1,4 @@
-"""Encounters: candidate pairs per replay step, CPA/TCPA, and the trigger (DESIGN §5 Replay).
+"""Encounters: candidate pairs per replay step, CPA/TCPA, and the trigger (docs/design.md §5).
 
 - ``cpa_tcpa``: closest point of approach under constant velocities.
 - ``find_encounters``: at each step, the pairs of moving vessels (SOG ≥ ``min_sog_kn``) within
@@ -31,7 +31,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import NoDataError
 from ..geo import ecef_m, in_tangent_plane, velocity_ecef_mps
-from .replay_params import ReplayParams
+from ..units import METRES_PER_NAUTICAL_MILE
 from .tracks import STATE_COLUMNS, Tracks
 
 # Below this relative speed (m/s) the vessels keep their distance: TCPA 0, CPA = range. One
@@ -41,6 +41,32 @@ from .tracks import STATE_COLUMNS, Tracks
 _STILL_MPS = 0.01
 # Vessel positions per batch of the pair search: bounds memory, keeps the work vectorised.
 _POINTS_PER_BATCH = 20_000
+
+
+def check_own_mmsi(own_mmsi: Iterable[int], vessels: NDArray[np.int64]) -> None:
+    """A ``NoDataError`` naming the first own MMSI that is not among ``vessels``."""
+    absent = sorted(set(own_mmsi) - set(vessels.tolist()))
+    if absent:
+        raise NoDataError(
+            f"own MMSI {absent[0]} is not in the AIS data after cleaning; check --own-mmsi "
+            "against the vessels in the input and the query's region and time window"
+        )
+
+
+@dataclass(frozen=True)
+class EncounterParams:
+    """What the pair search needs (the ``[replay]`` keys of the same names).
+
+    - ``min_sog_kn``: vessels slower than this are not under way and form no candidate pairs.
+    - ``candidate_range_m``: pairs closer than this (inclusive) are candidates (2 nm).
+    - ``tcpa_act_s``, ``cpa_req_m``: an encounter triggers at the first step with
+      ``0 <= TCPA <= tcpa_act_s`` and ``CPA < cpa_req_m`` (the paper's TCPA_act and CPA_req).
+    """
+
+    min_sog_kn: float = 0.5
+    candidate_range_m: float = 2.0 * METRES_PER_NAUTICAL_MILE
+    tcpa_act_s: float = 180.0
+    cpa_req_m: float = 150.0
 
 
 def cpa_tcpa(
@@ -84,7 +110,7 @@ def cpa_tcpa_vectors(
 
 
 def trigger_mask(
-    cpa_m: ArrayLike, tcpa_s: ArrayLike, rel_speed_mps: ArrayLike, params: ReplayParams
+    cpa_m: ArrayLike, tcpa_s: ArrayLike, rel_speed_mps: ArrayLike, params: EncounterParams
 ) -> NDArray[np.bool_]:
     """The paper's trigger ``0 <= TCPA <= tcpa_act_s and CPA < cpa_req_m``.
 
@@ -97,23 +123,6 @@ def trigger_mask(
         & (tcpa <= params.tcpa_act_s)
         & (np.asarray(cpa_m, dtype=float) < params.cpa_req_m)
         & (np.asarray(rel_speed_mps, dtype=float) >= _STILL_MPS)
-    )
-
-
-def velocity_mps(
-    speed_mps: ArrayLike, course_deg: ArrayLike
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(north, east) velocity components of a speed along a course.
-
-    The components are along the axes the course is measured from: give a grid course
-    (``cog_grid_deg``) for a velocity in the ``LocalFrame``.
-    """
-    course_rad = np.radians(np.asarray(course_deg, dtype=float))
-    speed = np.asarray(speed_mps, dtype=float)
-    at_rest = speed == 0.0  # no velocity whatever her course, known or not (geo.velocity_ecef_mps)
-    return (
-        np.where(at_rest, 0.0, speed * np.cos(course_rad)),
-        np.where(at_rest, 0.0, speed * np.sin(course_rad)),
     )
 
 
@@ -251,7 +260,7 @@ def candidate_pairs_nd(
 
 def find_encounters(
     tracks: Tracks,
-    params: ReplayParams,
+    params: EncounterParams,
     own_mmsi: Iterable[int] | None = None,
     counted_steps: tuple[int, int] | None = None,
     require_own: bool = True,
@@ -266,12 +275,7 @@ def find_encounters(
     samples = tracks.samples
     own = None if own_mmsi is None else frozenset(int(m) for m in own_mmsi)
     if own is not None and require_own:
-        absent = sorted(own - set(samples["mmsi"].unique().tolist()))
-        if absent:
-            raise NoDataError(
-                f"own MMSI {absent[0]} is not in the AIS data after cleaning; check --own-mmsi "
-                "against the vessels in the input and the query's region and time window"
-            )
+        check_own_mmsi(own, samples["mmsi"].unique())
     moving = samples["sog_kn"].to_numpy() >= params.min_sog_kn
     rows = np.flatnonzero(moving)
     step = samples["step"].to_numpy()[rows]
@@ -319,7 +323,7 @@ def _batch_runs(
     vessel: NDArray[np.intp],
     position: NDArray[np.float64],
     velocity: NDArray[np.float64],
-    params: ReplayParams,
+    params: EncounterParams,
 ) -> pd.DataFrame:
     """Runs of consecutive candidate steps per pair within one batch of steps."""
     swap = vessel[i] > vessel[j]

@@ -11,7 +11,7 @@
    (north, east). k = 0, the present position, is not projected: the arcs are the future
    positions, as in the paper. A vessel at rest (v = 0) projects every k onto its present
    position, so the estimator then checks the ellipse where she lies.
-3. Comfort zones (the paper's ellipse, with DESIGN §5's correction of its typo): an ellipse
+3. Comfort zones (the paper's ellipse, with docs/design.md §5's correction of its typo): an ellipse
    with semi-axis ``a = domain_length_factor·L`` along the heading at that point and
    ``b = domain_breadth_factor·B`` across it, as a 32-vertex polygon inscribed in the ellipse.
 4. A projected position is restricted when its ellipse is not properly inside the navigable
@@ -44,7 +44,8 @@ from ..config import dataclass_from_table
 from ..errors import ParameterError
 
 if TYPE_CHECKING:
-    from ..charts.chart import Chart, WaterIndex
+    from ..charts.water import Chart, WaterIndex
+    from .vessel_defaults import VesselDimensions
 
 ELLIPSE_VERTICES = 32
 # Consecutive projected positions tested together by the coarse distance filter.
@@ -294,7 +295,8 @@ def ellipse_polygons(
     np.multiply.outer(cos_h, forward_m, out=coords[:, :, 1])
     coords[:, :, 1] -= np.multiply.outer(sin_h, starboard_m)
     coords[:, :, 1] += north[:, None]
-    # One ragged-array call builds every ring and polygon (about twice shapely.polygons' speed).
+    # One ragged-array call builds every ring and polygon, faster than shapely.polygons
+    # (figures: tests/benchmarks/README.md).
     return shapely.from_ragged_array(
         shapely.GeometryType.POLYGON,
         coords.reshape(-1, 2),
@@ -418,6 +420,16 @@ class ManoeuvrabilityAssessment:
         return ellipse_polygons(self.north_m, self.east_m, self.heading_deg, self.a_m, self.b_m)
 
 
+@dataclass(frozen=True)
+class VesselState:
+    """The vessel's state in the run's local frame; ``course_deg`` is a grid course."""
+
+    north_m: float
+    east_m: float
+    course_deg: float
+    speed_mps: float
+
+
 def _check_target(**values: float) -> None:
     for name, value in values.items():
         if not math.isfinite(value):
@@ -431,16 +443,15 @@ def _check_target(**values: float) -> None:
 
 def assess_manoeuvrability(
     chart: Chart | None,
-    north_m: float,
-    east_m: float,
-    course_deg: float,
-    speed_mps: float,
-    length_m: float,
-    breadth_m: float,
-    draught_m: float,
+    state: VesselState,
+    dimensions: VesselDimensions,
     params: ManoeuvrabilityParams,
 ) -> ManoeuvrabilityAssessment:
     """Project both arcs, place the comfort zones and check them against the chart."""
+    north_m, east_m = state.north_m, state.east_m
+    course_deg, speed_mps = state.course_deg, state.speed_mps
+    length_m, breadth_m = dimensions.length_m, dimensions.breadth_m
+    draught_m = dimensions.draught_m
     _check_target(
         north_m=north_m,
         east_m=east_m,
@@ -506,10 +517,12 @@ def assess_manoeuvrability(
 
 
 def unplaced_assessment(
-    length_m: float, breadth_m: float, draught_m: float, params: ManoeuvrabilityParams
+    dimensions: VesselDimensions, params: ManoeuvrabilityParams
 ) -> ManoeuvrabilityAssessment:
     """The estimate for a vessel that has no place in the run's map frame (far beyond its
     reach, where no chart is): ``unknown``, with no projected positions."""
+    length_m, breadth_m = dimensions.length_m, dimensions.breadth_m
+    draught_m = dimensions.draught_m
     rate = params.alpha * target_rate_of_swing_deg_per_m(length_m, params)
     empty = np.empty(0, dtype=float)
     return ManoeuvrabilityAssessment(

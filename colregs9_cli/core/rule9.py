@@ -1,4 +1,4 @@
-"""The COLREGs rule 9 assessment automaton G_d (paper, Fig. "automaton_A"; DESIGN §5).
+"""The COLREGs rule 9 assessment automaton G_d (paper, Fig. "automaton_A"; docs/design.md §5).
 
 G_d = (D, E_d, f_d, D1, {D1, D4}) with
 
@@ -15,7 +15,7 @@ and the transition function ``TRANSITIONS`` (exactly the figure's six arrows):
 
 Events, as in the paper: d1 the target needs to give way under rules 13–15 (a crossing or
 overtaking in which own ship stands on, and every head-on); d2 the target's AIS navigational
-status is in the restricted set (``ReplayParams.restricted_nav_statuses``, default {3, 4});
+status is in the restricted set (``Rule9Params.restricted_nav_statuses``, default {3, 4});
 d3 the manoeuvrability estimator says the target is restricted. The estimator's "unknown" is
 ¬d3, recorded as ``unknown`` and never as "not restricted"; so is a missing nav status for d2.
 D4 means the target is not expected to give way: she stands on and own ship gives way.
@@ -56,6 +56,21 @@ from dataclasses import dataclass
 from enum import Enum, StrEnum
 
 from .colregs import Role, Situation
+
+
+@dataclass(frozen=True)
+class Rule9Params:
+    """What G_d needs beyond the pair (the ``[replay]`` keys of the same names).
+
+    - ``restricted_nav_statuses``: AIS navigational status codes that mean "restricted
+      manoeuvrability" for event d2 (3 restricted manoeuvrability, 4 constrained by her
+      draught).
+    - ``reassess_every_s``: after the trigger, a manoeuvrability estimate (event d3) is made
+      again only where G_d reaches D3 and the last one is at least this old (``core/pair.py``).
+    """
+
+    restricted_nav_statuses: frozenset[int] = frozenset({3, 4})
+    reassess_every_s: float = 10.0
 
 
 class State(Enum):
@@ -258,18 +273,6 @@ class PairVerdict:
         """G_d reached D4 in an overtaking, where rule 13 keeps the roles."""
         return self.situation is Situation.OVERTAKING and (
             self.seat_a.rule9_applied or self.seat_b.rule9_applied
-        )
-
-    def swapped(self) -> PairVerdict:
-        """The same verdict with the vessels in the other order."""
-        return PairVerdict(
-            situation=self.situation,
-            role_colregs=(self.role_colregs[1], self.role_colregs[0]),
-            seat_a=self.seat_b,
-            seat_b=self.seat_a,
-            role_final=(self.role_final[1], self.role_final[0]),
-            deciding_rule=self.deciding_rule,
-            both_restricted=self.both_restricted,
         )
 
 

@@ -1,4 +1,4 @@
-"""Per-vessel tracks: segmentation and resampling to the replay time step (DESIGN §5 Replay).
+"""Per-vessel tracks: segmentation and resampling to the replay time step (docs/design.md §5).
 
 Input: cleaned position reports in the canonical columns (``timestamp`` tz-aware UTC,
 ``mmsi``, ``lat_deg``, ``lon_deg``, ``sog_kn``, ``cog_deg``, ``heading_deg``, ``nav_status``,
@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from enum import StrEnum
 
 import numpy as np
 import pandas as pd
@@ -49,7 +50,32 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..geo import LocalFrame, ecef_m, normal_to_lat_lon, surface_normal, true_bearing_deg
 from ..units import MPS_PER_KNOT, signed_angle_deg, wrap_deg
-from .replay_params import CourseSource, ReplayParams
+
+
+class CourseSource(StrEnum):
+    """Which AIS field gives a vessel's course for bearings: COG, or heading (null → COG)."""
+
+    COG = "cog"
+    HEADING = "heading"
+
+
+@dataclass(frozen=True)
+class TrackParams:
+    """What the tracks need (the ``[replay]`` keys of the same names).
+
+    - ``step_s``: the replay time step Δt; tracks are resampled to multiples of it (UTC).
+    - ``max_gap_s``: a track is split where two reports are more than this apart.
+    - ``max_speed_kn``: a report whose implied speed from the previous kept report exceeds
+      this is an implausible jump (rule 2).
+    - ``min_sog_kn``: vessels slower than this are not under way: their samples are counted
+      apart, and only vessels under way are kept for the pair search.
+    """
+
+    step_s: float = 1.0
+    max_gap_s: float = 300.0
+    max_speed_kn: float = 50.0
+    min_sog_kn: float = 0.5
+
 
 REQUIRED_COLUMNS: tuple[str, ...] = (
     "timestamp",
@@ -209,7 +235,7 @@ class Segmented:
 def segment_reports(
     reports: pd.DataFrame,
     carry: pd.DataFrame,
-    params: ReplayParams,
+    params: TrackParams,
     until_s: float | None = None,
 ) -> Segmented:
     """Rules 1-3 on ``reports`` (``REPORT_COLUMNS``), all earlier than ``until_s`` and later
@@ -287,7 +313,7 @@ def segment_reports(
 def resample_reports(
     kept: pd.DataFrame,
     frame: LocalFrame,
-    params: ReplayParams,
+    params: TrackParams,
     course_source: CourseSource = CourseSource.COG,
     steps: tuple[int, int] | None = None,
     under_way_only: bool = False,
@@ -368,7 +394,7 @@ def resample_reports(
     return samples[list(SAMPLE_COLUMNS)]
 
 
-def context_s(params: ReplayParams) -> float:
+def context_s(params: TrackParams) -> float:
     """How far around a window of steps the reports must reach for its samples to be exact:
     the reports bracketing a sample are within ``max_gap_s`` of it, and rule 4 looks at
     their neighbours, within ``max_gap_s`` again."""
@@ -378,7 +404,7 @@ def context_s(params: ReplayParams) -> float:
 def build_tracks(
     positions: pd.DataFrame,
     frame: LocalFrame,
-    params: ReplayParams,
+    params: TrackParams,
     course_source: CourseSource = CourseSource.COG,
 ) -> Tracks:
     """Segment and resample ``positions`` in one go (see the module docstring for the rules).
@@ -407,7 +433,7 @@ def _drop_jumps(
     mmsi: NDArray[np.int64],
     t: NDArray[np.float64],
     where: NDArray[np.float64],
-    params: ReplayParams,
+    params: TrackParams,
 ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
     """(keep, split) masks for rule 2. Only vessels with a consecutive jump are walked.
 

@@ -1,4 +1,4 @@
-"""Dimensions for vessels that do not report them (DESIGN §5, "Missing dimensions").
+"""Dimensions for vessels that do not report them (docs/design.md §5, "Missing dimensions").
 
 A vessel without an AIS length, breadth or draught takes, for each missing dimension, the
 value of the first row of ``data/default_dimensions.csv`` that matches what AIS does say: her
@@ -20,8 +20,7 @@ from typing import Any
 
 import pandas as pd
 
-from ..ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
-from ..ais.schema import DIMENSIONS
+from ..vessels import DIMENSIONS, MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
 
 ANY = "*"
 
@@ -64,6 +63,22 @@ def _table_row(mobile_type: str | None, ship_type: str | None) -> pd.Series:
     raise LookupError("data/default_dimensions.csv has no '*,*' row")
 
 
+@dataclass(frozen=True)
+class DimensionDefaults:
+    """Values that replace the table for every vessel that does not report a dimension (the
+    ``[replay]`` keys ``default_length_m``, ``default_breadth_m``, ``default_draught_m``);
+    ``None``: take the table's value by mobile type and ship type."""
+
+    length_m: float | None = None
+    breadth_m: float | None = None
+    draught_m: float | None = None
+
+    def get(self, name: str) -> float | None:
+        """The override of dimension ``name`` (``length_m`` …), if any."""
+        value: float | None = getattr(self, name)
+        return value
+
+
 _LIMITS_M = {"length_m": MAX_LENGTH_M, "breadth_m": MAX_BREADTH_M, "draught_m": MAX_DRAUGHT_M}
 
 
@@ -77,18 +92,18 @@ def _reported(name: str, value: Any) -> float | None:
 
 
 def vessel_dimensions(
-    static: dict[str, Any], overrides: dict[str, float | None] | None = None
+    static: dict[str, Any], overrides: DimensionDefaults | None = None
 ) -> VesselDimensions:
     """Dimensions of one vessel from her static AIS (``length_m``, ``breadth_m``,
     ``draught_m``, ``ship_type``, ``mobile_type``; any may be missing).
 
-    ``overrides`` maps a dimension to a value that replaces the table for every vessel that
-    does not report it (``None``: use the table).
+    ``overrides`` give values that replace the table for every vessel that does not report
+    a dimension (``None``: use the table).
     """
     given = {name: _reported(name, static.get(name)) for name in DIMENSIONS}
     missing = tuple(name for name, value in given.items() if value is None)
     row = _table_row(_text(static.get("mobile_type")), _text(static.get("ship_type")))
-    overrides = overrides or {}
+    overrides = overrides or DimensionDefaults()
     values: dict[str, float] = {}
     for name in DIMENSIONS:
         reported, override = given[name], overrides.get(name)

@@ -8,16 +8,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt
 import numpy as np
 import pyogrio
 import shapely
+from matplotlib.figure import Figure
 
-from ..charts.chart import CellInfo, Chart, load_chart
+from ..charts.cells import CellInfo
+from ..charts.water import Chart, load_chart
 from ..errors import OutputError, ParameterError
 from ..outputs import atomic_path, check_out_file, save_figure
 from ..progress import progress_bar, progress_enabled
@@ -239,19 +236,18 @@ def summarise_chart(
         )
         return ChartSummary(chart, area_km2, out_path, text)
     plot_path = out_path
-    figure, ax = plt.subplots(figsize=(8, 8), layout="constrained")
-    try:
-        depths = draw_chart(ax, chart, draught_m, ukc_m, coverage=True)
-        figure.colorbar(depths, ax=ax, label="DRVAL1, shallowest depth (m)", shrink=0.7)
-        geographic_axes(ax, chart.frame)
-        ax.set_title(
-            f"{Path(paths[0]).name}: navigable water for draught {draught_m:g} m "
-            f"+ UKC {ukc_m:g} m ({area_km2:.3f} km²)",
-            fontsize="medium",
-        )
-        ax.legend(loc="lower right", fontsize="small")
-        save_figure(plot_path, figure, dpi=150)
-    finally:
-        plt.close(figure)
+    # A bare Figure, not pyplot's: no backend to choose, no figure left open (Agg on save).
+    figure = Figure(figsize=(8, 8), layout="constrained")
+    ax = figure.subplots()
+    depths = draw_chart(ax, chart, draught_m, ukc_m, coverage=True)
+    figure.colorbar(depths, ax=ax, label="DRVAL1, shallowest depth (m)", shrink=0.7)
+    geographic_axes(ax, chart.frame)
+    ax.set_title(
+        f"{Path(paths[0]).name}: navigable water for draught {draught_m:g} m "
+        f"+ UKC {ukc_m:g} m ({area_km2:.3f} km²)",
+        fontsize="medium",
+    )
+    ax.legend(loc="lower right", fontsize="small")
+    save_figure(plot_path, figure, dpi=150)
     text += f"Navigable water for draught {draught_m:g} m + UKC {ukc_m:g} m: {area_km2:.3f} km²\n"
     return ChartSummary(chart, area_km2, plot_path, text)

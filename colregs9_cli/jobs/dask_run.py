@@ -1,4 +1,4 @@
-"""Stage 2 of the replay (``slabs.replay_slab``) on dask.distributed (DESIGN §6).
+"""Stage 2 of the replay (``slabs.replay_slab``) on dask.distributed (docs/design.md §6).
 
 A ``LocalCluster`` of ``workers`` processes (one thread each: the work is NumPy and pandas
 under the GIL) by default, or the cluster whose scheduler is at ``scheduler``. The slabs'
@@ -20,14 +20,15 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import ExitStack, closing, contextmanager
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import dask
 import pyarrow as pa
 from distributed import Client, Future, LocalCluster, as_completed
 
-from ..charts.chart import Chart
+from ..charts.water import Chart
 from ..core.replay_results import EncounterOutcome, seats_in_order
 from ..errors import ParameterError
 from ..geo import LocalFrame
@@ -56,8 +57,9 @@ def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
             yield client
         return
     # Dask's nannies set MALLOC_TRIM_THRESHOLD_=65536 in their workers, so that freed memory
-    # goes back to the system at once; on a slab's arrays that makes every task 1.7x slower.
-    # A slab's memory is bounded anyway: keep glibc's own threshold. A worker's event loop
+    # goes back to the system at once; a slab's large arrays, allocated and freed again and
+    # again, then make every task much slower (figures: tests/benchmarks/README.md). A
+    # slab's memory is bounded anyway: keep glibc's own threshold. A worker's event loop
     # shares the GIL with its task: Dask's profiler samples the task's stack every 10 ms
     # (for a dashboard this cluster has not), and the loop wakes every 20 ms to time itself
     # and every 100 ms to measure the memory. A slab runs for seconds: check once a second.
@@ -85,8 +87,8 @@ def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
     # Not made the default client: that is a context variable of the thread that starts it
     # (``dask_client_soon``), and the run's own thread uses and closes it.
     with closing(cluster), closing(Client(cluster, set_as_default=False)) as client:
-        # The workers import the replay (pandas, shapely, matplotlib: a second or two each)
-        # now, while this process reads the input, not when the first slab arrives.
+        # The workers import the replay (pandas, shapely, matplotlib: slow imports) now,
+        # while this process reads the input, not when the first slab arrives.
         client.run(_ready, wait=False)
         yield client
 
@@ -94,10 +96,18 @@ def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
 async def _ready() -> None:
     """Unpickling it on a worker imports this module and so the whole replay (a coroutine,
     as Dask runs only those without waiting). A worker is one of the cluster's processes
-    sharing the machine: Arrow's thread pool of one thread per core would oversubscribe it.
-    It collects garbage as seldom as the console script does, which makes a slab 2-3 % faster."""
+    sharing the machine: Arrow's thread pool of one thread per core would oversubscribe it."""
     pa.set_cpu_count(1)
-    fewer_collections()
+
+
+def _seldom_collected(function: Callable[..., Part], /, *args: Any, **kwargs: Any) -> Part:
+    """``function(*args, **kwargs)``, as a task on a worker, collecting garbage as seldom as
+    the console script does (``quick_exit.fewer_collections``), and the worker's collector as
+    it was once the task is done. A task holds the same many long-lived objects as a command
+    (pandas, shapely, matplotlib), which the collector would walk again and again: fewer
+    collections make a slab a little faster (figures: tests/benchmarks/README.md)."""
+    with fewer_collections():
+        return function(*args, **kwargs)
 
 
 @contextmanager
@@ -127,7 +137,7 @@ def dask_slabs(
     and the slabs' results left on the workers, for the reports."""
     shared = client.scatter([context, chart], broadcast=True)
     futures = client.map(
-        replay_slab,
+        partial(_seldom_collected, replay_slab),
         list(slabs),
         job=shared[0],
         evaluate=evaluate,
@@ -156,7 +166,10 @@ class EncountersOnCluster:
     def map(
         self, function: Callable[[tuple[EncounterOutcome, ...]], Part]
     ) -> list[Callable[[], Part]]:
-        futures = [self.client.submit(_on_seats, function, slab, pure=False) for slab in self.slabs]
+        futures = [
+            self.client.submit(_seldom_collected, _on_seats, function, slab, pure=False)
+            for slab in self.slabs
+        ]
         return [future.result for future in futures]
 
 
@@ -181,7 +194,7 @@ def dask_drawer(client: Client) -> Drawer:
         # then ("lost dependencies") on a two-worker LocalCluster.
         with dask.config.set({"distributed.admin.large-graph-warning-threshold": "16GiB"}):
             futures = client.map(
-                draw_encounter,
+                partial(_seldom_collected, draw_encounter),
                 [outcome for outcome, _ in jobs],
                 [target for _, target in jobs],
                 chart=shared,
@@ -202,7 +215,7 @@ def dask_segments(
     """Stage 1 on the cluster: each part of the vessels (``replay_input.segment_input_part``
     with its arguments bound) as one task, ``bar`` advanced as each ends; the results in the
     order of ``parts``, whatever the order they end in."""
-    futures = [client.submit(part, pure=False) for part in parts]
+    futures = [client.submit(_seldom_collected, part, pure=False) for part in parts]
     order = {future.key: index for index, future in enumerate(futures)}
     results: dict[int, Part] = {}
     for future in as_completed(futures, loop=client.loop):

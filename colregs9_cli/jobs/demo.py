@@ -28,11 +28,13 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
+from ..charts.provenance import charts_manifest
 from ..core.replay_results import EncounterOutcome, ReplayResult
 from ..errors import InputFileError, NoDataError
 from ..outputs import REPORT_MARKER, check_out_dir, report_directory, write_json
-from ..provenance import charts_manifest, run_header
+from ..provenance import run_header
 from ..report.replay_report import ENCOUNTER_DIR
+from ..timebase import DISPLAY_TIME_FORMAT
 from .replay import run_replay
 from .simulate import SimulationResult, simulate_scenario
 
@@ -100,7 +102,7 @@ def verdict_rows(verdict: ScenarioVerdict) -> tuple[tuple[str, str], ...]:
     """(label, value) of one scenario's verdict, in the order printed."""
     s = verdict.outcome.summary
     return (
-        ("trigger (UTC)", s.trigger_utc.strftime("%Y-%m-%d %H:%M:%S")),
+        ("trigger (UTC)", s.trigger_utc.strftime(DISPLAY_TIME_FORMAT)),
         ("situation", s.situation.value),
         ("own role under COLREGs", s.own_role_colregs.value),
         ("target reports restricted", _yes_no(s.target_reports_restricted)),
@@ -160,8 +162,8 @@ def _own_outcome(replay: ReplayResult, own_mmsi: int, scenario: str) -> Encounte
     if not outcomes:
         raise NoDataError(
             f"scenario {scenario}: the replay found no triggered encounter for own ship MMSI "
-            f"{own_mmsi} (CPA < {replay.params.replay.cpa_req_m:g} m within 0 <= TCPA <= "
-            f"{replay.params.replay.tcpa_act_s:g} s); check the scenario and the query"
+            f"{own_mmsi} (CPA < {replay.params.encounters.cpa_req_m:g} m within 0 <= TCPA <= "
+            f"{replay.params.encounters.tcpa_act_s:g} s); check the scenario and the query"
         )
     return min(outcomes, key=lambda o: o.summary.trigger_utc)
 

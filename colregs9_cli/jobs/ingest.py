@@ -73,16 +73,13 @@ from ..ais.dataset_scan import (
     utc_ms,
 )
 from ..ais.duplicates import ROW_ORDER, repeated_rows
+from ..ais.inputs import InputFile, no_positions_error
+from ..ais.layouts import check_format
 from ..ais.ledger import RejectReason, RejectsLedger
-from ..ais.load import (
-    InputFile,
-    check_format,
-    ingest_params,
-    no_positions_error,
-    stream_ais,
-)
+from ..ais.load import stream_ais
 from ..ais.schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from ..ais.sources import Source, inspect_source, sha256_file
+from ..ais.time_sources import ingest_params
 from ..errors import InputFileError, NoDataError, OutputError, ParameterError
 from ..outputs import write_json
 from ..progress import ProgressSink, progress_bar, progress_enabled

@@ -1,4 +1,4 @@
-"""The AIS of a replay, one slab at a time, in bounded memory (DESIGN §6).
+"""The AIS of a replay, one slab at a time, in bounded memory (docs/design.md §6).
 
 AIS files are first ingested, under the replay's query, into a Parquet dataset in the
 scratch directory (``ais.dataset.ingest_with_query``, which streams them block by block);
@@ -37,13 +37,14 @@ import pandas as pd
 import pyarrow.compute as pc
 
 from ..ais.dataset_scan import Dataset, is_dataset, position_filter
+from ..ais.inputs import InputFile, no_positions_error
 from ..ais.ledger import RejectReason, RejectsLedger
-from ..ais.load import InputFile, canonical_frame, load_ais, no_positions_error
-from ..core.replay_params import ReplayParams
+from ..ais.load import canonical_frame, load_ais
 from ..errors import InputFileError
 from ..progress import ProgressSink
 from ..query import Query
 from .ingest import ingest_with_query, read_window_counted
+from .replay_params import ReplayParams
 from .slabs import Segmentation, SegmentedPart, merge_parts, segment_part, slab_of, slabs_of_frame
 
 __all__ = [

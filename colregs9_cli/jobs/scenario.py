@@ -7,7 +7,7 @@ route of waypoints (lat, lon) with a speed per leg. The format is documented in
 and impossible values raise ``QueryError`` naming the file, the vessel and the key.
 
 The plausibility check puts every waypoint and every leg of every route in water navigable
-for that vessel's draught on the scenario's chart (``chart.load_chart(...).navigable_water``:
+for that vessel's draught on the scenario's chart (``charts.water.load_chart(...).navigable_water``:
 depth areas with DRVAL1 >= draught, minus land), in the scenario's local frame.
 """
 
@@ -23,12 +23,12 @@ from typing import Any
 import numpy as np
 from shapely.geometry import LineString, Point
 
-from ..ais.clean import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M, MMSI_MAX, MMSI_MIN
-from ..charts.chart import Chart, load_chart
+from ..charts.water import Chart, load_chart
 from ..config import read_toml
 from ..errors import QueryError
 from ..geo import LocalFrame
 from ..query import is_report_name
+from ..vessels import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M, MMSI_MAX, MMSI_MIN
 
 _SCENARIO_KEYS = {
     "name": str,

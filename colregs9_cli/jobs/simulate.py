@@ -25,9 +25,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..ais.schema import NAV_STATUS_CODES
+from ..ais.layouts import DMA26
 from ..geo import LocalFrame
-from ..outputs import check_out_file, write_csv
+from ..outputs import check_out_file
 from ..progress import progress_bar, progress_enabled
 from ..units import knots_to_mps, wrap_deg
 from .scenario import (
@@ -38,38 +38,8 @@ from .scenario import (
     scenario_frame,
 )
 
-DMA_COLUMNS: tuple[str, ...] = (
-    "# Timestamp",
-    "Type of mobile",
-    "MMSI",
-    "Latitude",
-    "Longitude",
-    "Navigational status",
-    "ROT",
-    "SOG",
-    "COG",
-    "Heading",
-    "IMO",
-    "Callsign",
-    "Name",
-    "Ship type",
-    "Cargo type",
-    "Width",
-    "Length",
-    "Type of position fixing device",
-    "Draught",
-    "Destination",
-    "ETA",
-    "Data source type",
-    "A",
-    "B",
-    "C",
-    "D",
-)
-DMA_TIME_FORMAT = "%d/%m/%Y %H:%M:%S"
-
-# DMA spells these differently from ITU-R M.1371 (DESIGN §4); the readers map both back.
-_DMA_NAV_STATUS = {**NAV_STATUS_CODES, 3: "Restricted manoeuverability"}
+# The layout simulate writes, through its writer: the columns, time format and status texts.
+_DMA_CSV = DMA26.csv_writer()
 
 
 @dataclass(frozen=True)
@@ -154,15 +124,13 @@ def dma_rows(track: VesselTrack, start_utc: dt.datetime) -> pd.DataFrame:
     """The track as DMA 26-column rows (text cells, formatted as DMA writes them)."""
     vessel = track.vessel
     cog = np.round(track.cog_deg, 1) % 360.0
-    stamps = [
-        (start_utc + dt.timedelta(seconds=float(t))).strftime(DMA_TIME_FORMAT) for t in track.time_s
-    ]
+    stamps = [_DMA_CSV.time_text(start_utc + dt.timedelta(seconds=float(t))) for t in track.time_s]
     half_length = vessel.length_m / 2.0
     half_breadth = vessel.breadth_m / 2.0
     static = {
         "Type of mobile": "Class A",
         "MMSI": str(vessel.mmsi),
-        "Navigational status": _DMA_NAV_STATUS[vessel.nav_status],
+        "Navigational status": _DMA_CSV.nav_status_text(vessel.nav_status),
         "ROT": "0",
         "IMO": str(vessel.imo) if vessel.imo is not None else "Unknown",
         "Callsign": vessel.callsign,
@@ -193,7 +161,7 @@ def dma_rows(track: VesselTrack, start_utc: dt.datetime) -> pd.DataFrame:
     )
     for column, value in static.items():
         frame[column] = value
-    return frame[list(DMA_COLUMNS)]
+    return frame[list(_DMA_CSV.columns)]
 
 
 def simulate(scenario: Scenario, quiet: bool = True) -> tuple[VesselTrack, ...]:
@@ -223,5 +191,5 @@ def simulate_scenario(path: Path, out: Path | None = None, quiet: bool = True) -
         (rows["MMSI"].astype(np.int64).to_numpy(), np.concatenate([t.time_s for t in tracks]))
     )
     rows = rows.iloc[order].reset_index(drop=True)
-    write_csv(target, rows)
+    _DMA_CSV.write(target, rows)
     return SimulationResult(scenario=scenario, out_path=target, tracks=tracks, rows=len(rows))

@@ -1,4 +1,4 @@
-"""Replay through time in slabs, in bounded memory, with the results of one go (DESIGN §6).
+"""Replay through time in slabs, in bounded memory, with the results of one go (docs/design.md §6).
 
 **Stage 1, segmentation** (``segment_part``, one pass in time order): the positions of each
 slab are segmented (``tracks.segment_reports``, which carries each vessel's last kept report
@@ -42,13 +42,13 @@ import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 from numpy.typing import NDArray
 
-from ..charts.chart import Chart
+from ..charts.water import Chart
 from ..core.encounters import Encounter, find_encounters
-from ..core.replay_params import CourseSource, ReplayParams
 from ..core.replay_results import PairOutcome
 from ..core.tracks import (
     KEPT_COLUMNS,
     NO_TRACK_STATS,
+    CourseSource,
     Tracks,
     TrackStats,
     context_s,
@@ -61,6 +61,8 @@ from ..core.tracks import (
 )
 from ..geo import LocalFrame
 from ..progress import ProgressSink
+from ..timebase import DISPLAY_TIME_FORMAT
+from .replay_params import ReplayParams
 
 # Sums of sines and cosines of longitudes in fixed point, so that the frame's centre does
 # not depend on the order in which slabs add them up.
@@ -209,7 +211,7 @@ def slabs_of_frame(positions: pd.DataFrame, slab_s: float) -> Iterator[tuple[int
 def slab_label(index: int, slab_s: float) -> str:
     """The slab's start in UTC, for progress bars."""
     start = datetime.fromtimestamp(index * slab_s, UTC)
-    return start.strftime("%Y-%m-%d %H:%M:%S UTC")
+    return start.strftime(f"{DISPLAY_TIME_FORMAT} UTC")
 
 
 @dataclass(frozen=True)
@@ -264,7 +266,7 @@ def segment_part(
         # After the part's last slab its vessels have no more reports, whatever other parts
         # have: their pending jumps are decided here, as one part decides them later.
         until_s = None if following is None else (index + 1) * params.slab_s
-        segmented = segment_reports(reports, carry, params, until_s)
+        segmented = segment_reports(reports, carry, params.tracks, until_s)
         carry = segmented.carry
         stats = stats + segmented.stats
         kept = segmented.kept
@@ -359,12 +361,12 @@ def _tracks(job: SlabContext, steps: tuple[int, int], mmsis: Sequence[int] | Non
     """Exact samples at ``steps``: of the vessels under way, or of ``mmsis`` whatever
     their speed."""
     params = job.params
-    margin_s = context_s(params)
+    margin_s = context_s(params.tracks)
     reports = job.spill.read(
         steps[0] * params.step_s - margin_s, steps[1] * params.step_s + margin_s, mmsis
     )
     samples = resample_reports(
-        reports, job.frame, params, job.course_source, steps, under_way_only=mmsis is None
+        reports, job.frame, params.tracks, job.course_source, steps, under_way_only=mmsis is None
     )
     return Tracks(
         samples=samples,
@@ -399,7 +401,7 @@ def replay_slab(
     window = (core[0] - 1, core[1] + tail_steps(params))
     tracks = _tracks(job, window, None)
     own = job.own_mmsi or None
-    search = find_encounters(tracks, params, own, counted_steps=core, require_own=False)
+    search = find_encounters(tracks, params.encounters, own, counted_steps=core, require_own=False)
     # Seats of encounters still going on at the window's end are followed, all together.
     PairKey = tuple[int, int, int]
     slots: list[tuple[Encounter, Tracks] | tuple[PairKey, tuple[int, int]]] = []
@@ -465,7 +467,7 @@ def _follow(
         vessels = sorted({m for _, a, b in pending for m in (a, b)})
         own = [m for m in job.own_mmsi if m in vessels] if job.own_mmsi else None
         tracks = _tracks(job, steps, vessels)
-        search = find_encounters(tracks, params, own, require_own=False)
+        search = find_encounters(tracks, params.encounters, own, require_own=False)
         seats: dict[tuple[int, int, int], list[Encounter]] = {}
         for encounter in search.encounters:
             a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))

@@ -2,9 +2,10 @@
 (``colregs9_cli.core.dimensions``) and write the reports (``report/stats_report.py``).
 
 The first input starts being read before pandas and matplotlib are imported: their import
-takes about half a second on one core, and the CSV parse takes the other meanwhile
-(``ais.csv_read.start_reading``). So this module imports them, and everything else the
-reading does not need (shapely, ``pyarrow.compute``), only inside ``run_stats``.
+keeps one core busy for a good while, and the CSV parse takes the other meanwhile
+(``ais.csv_read.start_reading``; figures: tests/benchmarks/README.md). So this module
+imports them, and everything else the reading does not need (shapely, ``pyarrow.compute``),
+only inside ``run_stats``.
 """
 
 from __future__ import annotations
@@ -72,13 +73,25 @@ def run_stats(
         check_out_dir(target, overwrite, inputs=[*paths, *([query_path] if query_path else [])])
         from ..ais.load import count_ais
         from ..core.dimensions import GroupBy, Per, dimension_stats
-        from ..report.stats_report import build_manifest, format_text, write_stats_reports
+        from ..provenance import inputs_manifest
+        from ..report.stats_report import (
+            StatsInputs,
+            build_manifest,
+            format_text,
+            write_stats_reports,
+        )
 
         per = _choice(Per, per, "--per")
         by = None if by is None else _choice(GroupBy, by, "--by")
         data = count_ais(paths, query=query, fmt=fmt, quiet=quiet, started=started)
     result = dimension_stats(data.position_counts, data.dimension_reports, per=per, by=by)
-    manifest = build_manifest(result, query, data)
+    read = StatsInputs(
+        inputs=inputs_manifest(data.inputs),
+        rows_read=data.ledger.rows_read,
+        rows_in_query=data.rows_in_query,
+        ledger=data.ledger.to_dict(),
+    )
+    manifest = build_manifest(result, query, read)
     files = write_stats_reports(target, result, query.name, manifest)
     return StatsRun(
         result=result,

@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib.pyplot as plt
 import pandas as pd
 
 from ..core.manoeuvrability import ManoeuvrabilityParams, reference_vessels
@@ -55,13 +54,10 @@ def run_swing(out_dir: Path | None = None, overwrite: bool = False) -> SwingRepo
     # run.json marks the directory as a colregs9 report, which a rerun may then replace.
     manifest = {**run_header("swing"), "fixed_swing_deg_per_m": defaults.swing_deg_per_m}
     figure = rate_of_swing_figure(table, defaults.swing_deg_per_m)
-    try:
-        with report_directory(out_dir) as staging:
-            write_csv(staging / CSV_NAME, table)
-            save_figure(staging / PNG_NAME, figure, dpi=150)
-            write_json(staging / REPORT_MARKER, manifest)
-    finally:
-        plt.close(figure)
+    with report_directory(out_dir) as staging:
+        write_csv(staging / CSV_NAME, table)
+        save_figure(staging / PNG_NAME, figure, dpi=150)
+        write_json(staging / REPORT_MARKER, manifest)
     return SwingReport(
         table, out_dir, out_dir / CSV_NAME, out_dir / PNG_NAME, format_swing_table(table)
     )

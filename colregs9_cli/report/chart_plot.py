@@ -12,10 +12,6 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-
 import numpy as np
 import shapely
 from matplotlib import colormaps
@@ -28,7 +24,7 @@ from matplotlib.ticker import FuncFormatter, MaxNLocator
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
 if TYPE_CHECKING:
-    from ..charts.chart import Chart
+    from ..charts.water import Chart
     from ..core.manoeuvrability import ManoeuvrabilityAssessment
     from ..geo import LocalFrame
 

@@ -17,6 +17,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from ..timebase import DISPLAY_TIME_FORMAT
+
 HTML_NAME = "index.html"
 
 _STYLE = """
@@ -139,7 +141,7 @@ def cell_text(value: Any) -> str:
         # Tenths below 1000, so that a CPA of 149.8 m does not read as the 150 m threshold.
         return f"{value:.0f}" if abs(value) >= 1000 else f"{value:.1f}"
     if isinstance(value, pd.Timestamp):
-        return value.strftime("%Y-%m-%d %H:%M:%S")
+        return value.strftime(DISPLAY_TIME_FORMAT)
     return str(getattr(value, "value", value))
 
 

@@ -14,7 +14,6 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 import matplotlib
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
@@ -23,7 +22,7 @@ from .chart_plot import Bounds, draw_chart, geographic_axes, show_view
 from .html_page import cell_text, file_links, page, sortable_table
 
 if TYPE_CHECKING:
-    from ..charts.chart import Chart
+    from ..charts.water import Chart
 
 ENCOUNTER_TABLE_COLUMNS = (
     "encounter",
@@ -196,7 +195,8 @@ def overview_figure(result: ReplayResult, chart: Chart | None) -> Figure:
     map_height_in = MAP_HEIGHT_IN - bottom - top
     view_width_m, view_height_m = view[2] - view[0], view[3] - view[1]
     width_in = float(np.clip(map_height_in * view_width_m / view_height_m + left + right, 5, 12))
-    figure, ax = plt.subplots(figsize=(width_in, MAP_HEIGHT_IN))
+    figure = Figure(figsize=(width_in, MAP_HEIGHT_IN))
+    ax = figure.subplots()
     figure.subplots_adjust(
         left=left / width_in,
         right=1 - right / width_in,
@@ -248,7 +248,7 @@ def overview_figure(result: ReplayResult, chart: Chart | None) -> Figure:
         ax.set_xlabel("longitude (°E)")
         ax.set_ylabel("latitude (°N)")
     if seen:
-        # Beside the map: matplotlib's "best" place costs a second over hundreds of pairs.
+        # Beside the map: matplotlib's "best" place is slow to find over hundreds of pairs.
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize="small")
     ax.set_title(
         f"{len(result.pairs)} triggered pairs at their trigger positions,\n"
@@ -261,13 +261,10 @@ def overview_figure(result: ReplayResult, chart: Chart | None) -> Figure:
 def overview_svg(result: ReplayResult, chart: Chart | None) -> str:
     """``overview_figure`` as an inline SVG."""
     figure = overview_figure(result, chart)
-    try:
-        buffer = io.StringIO()
-        # No date and fixed element ids: the same run gives the same page.
-        with matplotlib.rc_context({"svg.hashsalt": "colregs9"}):
-            figure.savefig(buffer, format="svg", bbox_inches="tight", metadata={"Date": None})
-    finally:
-        plt.close(figure)
+    buffer = io.StringIO()
+    # No date and fixed element ids: the same run gives the same page.
+    with matplotlib.rc_context({"svg.hashsalt": "colregs9"}):
+        figure.savefig(buffer, format="svg", bbox_inches="tight", metadata={"Date": None})
     svg = buffer.getvalue()
     # matplotlib opens every link in a new window; a pair's number filters this page's table.
     return svg[svg.index("<svg") :].replace(' target="_blank"', "")
@@ -287,8 +284,8 @@ def replay_html(
     body = [
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{counts.vessels} vessels; {counts.encounters} encounters, {counts.triggered} "
-        f"triggered (CPA &lt; {result.params.replay.cpa_req_m:g} m within 0 ≤ TCPA ≤ "
-        f"{result.params.replay.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs. Files: "
+        f"triggered (CPA &lt; {result.params.encounters.cpa_req_m:g} m within 0 ≤ TCPA ≤ "
+        f"{result.params.encounters.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs. Files: "
         f"{file_links(files)}.</p>",
     ]
     if result.pairs:

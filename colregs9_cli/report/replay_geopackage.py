@@ -36,7 +36,7 @@ import pandas as pd
 import pyogrio
 import shapely
 
-from ..charts.chart import Chart
+from ..charts.water import Chart
 from ..core.replay_results import EncounterOutcome, EncounterSummary, ReplayResult
 from ..geo import LocalFrame
 from ..outputs import atomic_path

@@ -16,24 +16,15 @@ from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from ..core.replay_results import (
-    ENCOUNTER_COLUMNS,
-    PAIR_COLUMNS,
-    EncounterOutcome,
-    PairOutcome,
-    ReplayResult,
-)
+from ..core.replay_results import EncounterOutcome, PairOutcome, ReplayResult
+from ..core.rows import ENCOUNTER_COLUMNS, PAIR_COLUMNS
 from ..outputs import report_directory, save_figure, write_csv, write_json, write_text
+from ..timebase import DISPLAY_TIME_FORMAT
 from .chart_plot import (
     DEPTH_LABEL,
     NOT_CHARTED_LABEL,
@@ -49,7 +40,7 @@ from .html_report import replay_html
 from .replay_geopackage import GEOPACKAGE_NAME, encounter_layers, write_replay_geopackage
 
 if TYPE_CHECKING:
-    from ..charts.chart import Chart
+    from ..charts.water import Chart
     from ..geo import LocalFrame
     from ..progress import ProgressSink
 
@@ -154,8 +145,8 @@ def format_summary(result: ReplayResult) -> str:
     if not result.pairs:
         lines.append(
             "No triggered encounters: no pair came within "
-            f"CPA < {result.params.replay.cpa_req_m:g} m with 0 <= TCPA <= "
-            f"{result.params.replay.tcpa_act_s:g} s. pairs.csv and encounters.csv have a "
+            f"CPA < {result.params.encounters.cpa_req_m:g} m with 0 <= TCPA <= "
+            f"{result.params.encounters.tcpa_act_s:g} s. pairs.csv and encounters.csv have a "
             "header only."
         )
         return "\n".join(lines) + "\n"
@@ -422,7 +413,8 @@ def encounter_figure(
     trigger and of the predicted CPA.
     """
     s = outcome.summary
-    figure, ax = plt.subplots(figsize=(8.5, 9.2), layout="constrained")
+    figure = Figure(figsize=(8.5, 9.2), layout="constrained")
+    ax = figure.subplots()
     view = _view_box(outcome)
     # The chart lives in the run's frame; a pair beyond its reach has a frame of its own.
     if not outcome.in_run_frame:
@@ -463,7 +455,8 @@ def encounter_figure(
     geographic_axes(ax, frame)
     _legend_below(figure, ax)
     at_cpa = s.trigger_utc + pd.Timedelta(seconds=s.tcpa_s)
-    times = f"trigger {s.trigger_utc:%Y-%m-%d %H:%M:%S} UTC, CPA predicted at {at_cpa:%H:%M:%S}"
+    trigger = s.trigger_utc.strftime(DISPLAY_TIME_FORMAT)
+    times = f"trigger {trigger} UTC, CPA predicted at {at_cpa:%H:%M:%S}"
     ax.set_title(f"{s.encounter_id}  ({times})\n{_verdict(outcome)}", fontsize="medium")
     return figure
 
@@ -477,8 +470,8 @@ def format_index(result: ReplayResult, plots: bool) -> str:
         "",
         f"{counts.vessels} vessels; {counts.encounters} encounters (a pair within range of "
         f"each other, seen from each reported seat), {counts.triggered} of them triggered "
-        f"(CPA < {result.params.replay.cpa_req_m:g} m within 0 <= TCPA <= "
-        f"{result.params.replay.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs.",
+        f"(CPA < {result.params.encounters.cpa_req_m:g} m within 0 <= TCPA <= "
+        f"{result.params.encounters.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs.",
         "",
         f"- [{PAIRS_NAME}]({PAIRS_NAME}): one row per triggered pair, with the pair-level "
         "verdict (the same whichever vessel is own ship).",
@@ -522,11 +515,7 @@ def draw_encounter(
     outcome: EncounterOutcome, target: Path, chart: Chart | None, ukc_m: float, frame: LocalFrame
 ) -> Path:
     """One encounter's figure, saved to ``target``."""
-    figure = encounter_figure(outcome, chart, ukc_m, frame)
-    try:
-        save_figure(target, figure, dpi=120)
-    finally:
-        plt.close(figure)
+    save_figure(target, encounter_figure(outcome, chart, ukc_m, frame), dpi=120)
     return target
 
 

@@ -7,6 +7,7 @@ module only lays them out.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -18,11 +19,10 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from ..outputs import report_directory, save_figure, write_csv, write_json, write_text
-from ..provenance import inputs_manifest, query_manifest, run_header
+from ..provenance import query_manifest, run_header
 from .html_page import HTML_NAME, stats_html
 
 if TYPE_CHECKING:
-    from ..ais.load import CountedAis
     from ..core.dimensions import StatsResult, StatsTable
     from ..query import Query
 
@@ -160,7 +160,8 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     (``type_colours``), each stack (a ``BarContainer``) labelled with its type, and one legend
     for all the types."""
     # A bare Figure renders with Agg on save, without pyplot's backend machinery. Fixed
-    # margins: a layout engine would double the time of drawing these three panels.
+    # margins: a layout engine would cost more than drawing these three panels does
+    # (figures: tests/benchmarks/README.md).
     figure = Figure(figsize=(13, 4))
     figure.subplots_adjust(left=0.05, right=0.99, bottom=0.13, top=0.82, wspace=0.22)
     axes = figure.subplots(1, 3)
@@ -192,7 +193,7 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
                     stack.set_label(name)
         else:
             axis.text(0.5, 0.5, "no values", ha="center", va="center", transform=axis.transAxes)
-        # Few ticks: each costs about a millisecond to make and draw.
+        # Few ticks: each tick label is costly to make and draw.
         axis.xaxis.set_major_locator(MaxNLocator(nbins=6))
         axis.yaxis.set_major_locator(MaxNLocator(nbins=5, integer=True))
         axis.set_xlabel(label)
@@ -211,15 +212,27 @@ def histogram_figure(result: StatsResult, query_name: str) -> Figure:
     return figure
 
 
-def build_manifest(result: StatsResult, query: Query, data: CountedAis) -> dict[str, Any]:
+@dataclass(frozen=True)
+class StatsInputs:
+    """What the statistics were computed from, as run.json records it: each input file
+    (``provenance.inputs_manifest``), the rows read, the rows the query kept, and the rejects
+    ledger (its ``to_dict``)."""
+
+    inputs: list[dict[str, Any]]
+    rows_read: int
+    rows_in_query: int
+    ledger: dict[str, Any]
+
+
+def build_manifest(result: StatsResult, query: Query, read: StatsInputs) -> dict[str, Any]:
     """The content of run.json: what was read, what the query kept, and the result."""
     return {
         **run_header("stats"),
         "query": query_manifest(query),
-        "inputs": inputs_manifest(data.inputs),
-        "rows_read": data.ledger.rows_read,
-        "rows_in_query": data.rows_in_query,
-        "ledger": data.ledger.to_dict(),
+        "inputs": read.inputs,
+        "rows_read": read.rows_read,
+        "rows_in_query": read.rows_in_query,
+        "ledger": read.ledger,
         "per": result.per.value,
         "by": None if result.by is None else result.by.value,
         "vessels": result.vessels,

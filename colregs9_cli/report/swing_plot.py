@@ -2,11 +2,6 @@
 
 from __future__ import annotations
 
-import matplotlib
-
-matplotlib.use("Agg")
-
-import matplotlib.pyplot as plt
 import pandas as pd
 from matplotlib.figure import Figure
 
@@ -33,7 +28,8 @@ def rate_of_swing_figure(
     Horizontal lines: the table's lower bound and the paper's fixed δ_swing; with ``alpha``,
     also the fixed value scaled by α.
     """
-    figure, ax = plt.subplots(figsize=(7, 5), layout="constrained")
+    figure = Figure(figsize=(7, 5), layout="constrained")
+    ax = figure.subplots()
     for vessel_type, rows in table.groupby("vessel_type", sort=False):
         marker, colour = CLASS_STYLES.get(str(vessel_type), OTHER_STYLE)
         ax.scatter(

@@ -37,16 +37,19 @@ import shapely
 from numpy.typing import NDArray
 from shapely.ops import polylabel
 
-from colregs9_cli.charts.chart import Chart, load_chart
+from colregs9_cli.charts.water import Chart, load_chart
 from colregs9_cli.core.manoeuvrability import (
     ManoeuvrabilityParams,
+    VesselState,
     assess_manoeuvrability,
     target_rate_of_swing_deg_per_m,
     turning_arcs,
 )
+from colregs9_cli.core.vessel_defaults import VesselDimensions
 
 ENC = Path(__file__).resolve().parents[2] / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
 DRAUGHT_M, LENGTH_M, BREADTH_M = 5.0, 50.0, 9.0
+DIMENSIONS = VesselDimensions(LENGTH_M, BREADTH_M, DRAUGHT_M, defaulted=(), basis="")
 SPEED_MPS = 7.0 * 1852.0 / 3600.0
 SAMPLE_SIZE = 100
 
@@ -151,7 +154,7 @@ def main() -> None:
         red = 0
         for north, east, course in starts:
             fast = assess_manoeuvrability(
-                chart, north, east, course, SPEED_MPS, LENGTH_M, BREADTH_M, DRAUGHT_M, params
+                chart, VesselState(north, east, course, SPEED_MPS), DIMENSIONS, params
             )
             for water in (index.water, unprepared):
                 assert (_loop_assessment(water, north, east, course) == fast.restricted).all()
@@ -159,7 +162,7 @@ def main() -> None:
         runs: dict[str, Callable[[], object]] = {
             "vectorised": _cycle(
                 lambda n, e, c: assess_manoeuvrability(
-                    chart, n, e, c, SPEED_MPS, LENGTH_M, BREADTH_M, DRAUGHT_M, params
+                    chart, VesselState(n, e, c, SPEED_MPS), DIMENSIONS, params
                 ),
                 starts,
             ),

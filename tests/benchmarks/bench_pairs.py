@@ -25,9 +25,9 @@ import numpy as np
 import pandas as pd
 
 from colregs9_cli.core.encounters import find_encounters
-from colregs9_cli.core.replay_params import ReplayParams
 from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.geo import LocalFrame
+from colregs9_cli.jobs.replay_params import ReplayParams
 from colregs9_cli.units import MPS_PER_KNOT
 
 FRAME = LocalFrame(57.05, 9.94)
@@ -85,10 +85,10 @@ def main() -> None:
         )
         reports = harbour_reports(vessels, args.minutes, side_m)
         started = time.perf_counter()
-        tracks = build_tracks(reports, FRAME, params)
+        tracks = build_tracks(reports, FRAME, params.tracks)
         tracks_s = time.perf_counter() - started
         started = time.perf_counter()
-        search = find_encounters(tracks, params)
+        search = find_encounters(tracks, params.encounters)
         search_s = time.perf_counter() - started
         per_pair_us = 1e6 * search_s / max(search.candidate_pair_steps, 1)
         print(

@@ -24,12 +24,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from colregs9_cli.ais.layouts import DMA_COLUMNS
 from colregs9_cli.core.encounters import find_encounters
-from colregs9_cli.core.replay_params import ReplayParams
 from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.geo import LocalFrame
 from colregs9_cli.jobs.replay import run_replay
-from colregs9_cli.jobs.simulate import DMA_COLUMNS
+from colregs9_cli.jobs.replay_params import ReplayParams
 from colregs9_cli.units import MPS_PER_KNOT
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -173,22 +173,24 @@ def bench_pair_search(duration_s: float, side_m_300: float) -> None:
     print("pair search (find_encounters), constant density:")
     for vessels in (100, 200, 300):
         side_m = side_m_300 * np.sqrt(vessels / 300.0)
-        tracks = build_tracks(harbour_positions(vessels, duration_s, 10.0, side_m), frame, params)
+        tracks = build_tracks(
+            harbour_positions(vessels, duration_s, 10.0, side_m), frame, params.tracks
+        )
         search = timed(
             f"  {vessels} vessels, {side_m / 1000:.1f} km square, {len(tracks.samples):,} samples",
-            lambda tracks=tracks: find_encounters(tracks, params),
+            lambda tracks=tracks: find_encounters(tracks, params.encounters),
             repeat=2,
         )
         print(f"    {search.candidate_pair_steps:,} candidate pair-steps")
     print("pair search, subsets of the 300-vessel harbour (fixed area):")
-    full = build_tracks(harbour_positions(300, duration_s, 10.0, side_m_300), frame, params)
+    full = build_tracks(harbour_positions(300, duration_s, 10.0, side_m_300), frame, params.tracks)
     mmsis = np.sort(full.samples["mmsi"].unique())
     for vessels in (100, 200, 300):
         keep = full.samples["mmsi"].isin(mmsis[:vessels])
         subset = dataclasses.replace(full, samples=full.samples[keep])
         search = timed(
             f"  {vessels} vessels, {len(subset.samples):,} samples",
-            lambda subset=subset: find_encounters(subset, params),
+            lambda subset=subset: find_encounters(subset, params.encounters),
             repeat=2,
         )
         print(f"    {search.candidate_pair_steps:,} candidate pair-steps")

@@ -23,7 +23,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 
-from colregs9_cli.jobs.simulate import DMA_COLUMNS
+from colregs9_cli.ais.layouts import DMA_COLUMNS
 
 HEADER = list(DMA_COLUMNS)
 

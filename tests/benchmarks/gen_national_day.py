@@ -28,7 +28,7 @@ the chosen duration at its own rate:
 The day starts at ``--start`` (default 2013-11-12 00:00:00 UTC, so that a 24 h day stays
 on one date). The work is vectorised over vessels and done in time blocks of
 ``BLOCK_S`` (600 s), each written out as soon as it is made, so memory does not grow with
-the duration. The output is a DMA 26-column CSV (``colregs9_cli.jobs.simulate.DMA_COLUMNS``,
+the duration. The output is a DMA 26-column CSV (``colregs9_cli.ais.layouts.DMA_COLUMNS``,
 ``dd/mm/yyyy HH:MM:SS`` timestamps, static data on every row, ``Unknown`` and empty for
 values not known), sorted by time then MMSI; ``--gzip`` (or a ``.gz`` name) compresses it.
 
@@ -54,8 +54,8 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.csv as pacsv
 
-from colregs9_cli.ais.schema import NAV_STATUS_CODES
-from colregs9_cli.jobs.simulate import DMA_COLUMNS
+from colregs9_cli.ais.layouts import DMA_COLUMNS
+from colregs9_cli.vessels import NAV_STATUS_CODES
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLE_NAME = "dma_nmea_2013-11-12_5min.txt.gz"

@@ -1,8 +1,11 @@
-"""Parameters of the replay: the ``[replay]`` table of a query TOML.
+"""Parameters of the replay: the ``[replay]`` table of a query TOML, composed of the core
+stages' own parameters.
 
 One table holds every knob of the tracks → encounters → rule 9 chain, so that a query file
-states the replay in one place. Defaults are the paper's Table "Simulation parameters"
-(time step 1 s, TCPA_act 3 min, CPA_req 150 m) and DESIGN §5.
+states the replay in one place; each core stage takes only its part (``TrackParams``,
+``EncounterParams``, ``ConductParams``, ``Rule9Params``, ``DimensionDefaults``). Defaults are
+the paper's Table "Simulation parameters" (time step 1 s, TCPA_act 3 min, CPA_req 150 m) and
+docs/design.md §5.
 
 ``[colregs]`` (sector angles, course source) is ``ColregsParams`` in ``colregs.py``.
 """
@@ -11,20 +14,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from enum import StrEnum
 from typing import Any
 
 from ..config import dataclass_from_table
+from ..core.audit import ConductParams
+from ..core.colregs import ColregsParams
+from ..core.encounters import EncounterParams
+from ..core.manoeuvrability import ManoeuvrabilityParams
+from ..core.pair import PairParams
+from ..core.rule9 import Rule9Params
+from ..core.tracks import TrackParams
+from ..core.vessel_defaults import DimensionDefaults
 from ..errors import ParameterError
 from ..units import METRES_PER_NAUTICAL_MILE
-
-
-class CourseSource(StrEnum):
-    """Which AIS field gives a vessel's course for bearings: COG, or heading (null → COG)."""
-
-    COG = "cog"
-    HEADING = "heading"
-
 
 # The most steps one vessel may have in a slab's window: 13 float columns of 8 bytes make a
 # gigabyte per vessel at 1e7.
@@ -89,12 +91,33 @@ class ReplayParams:
     slab_s: float = 1800.0
 
     @property
-    def dimension_overrides(self) -> dict[str, float | None]:
-        return {
-            "length_m": self.default_length_m,
-            "breadth_m": self.default_breadth_m,
-            "draught_m": self.default_draught_m,
-        }
+    def tracks(self) -> TrackParams:
+        return TrackParams(self.step_s, self.max_gap_s, self.max_speed_kn, self.min_sog_kn)
+
+    @property
+    def encounters(self) -> EncounterParams:
+        return EncounterParams(
+            self.min_sog_kn, self.candidate_range_m, self.tcpa_act_s, self.cpa_req_m
+        )
+
+    @property
+    def conduct(self) -> ConductParams:
+        return ConductParams(
+            self.course_change_deg,
+            self.speed_change_frac,
+            self.speed_change_min_kn,
+            self.course_judged_above_kn,
+        )
+
+    @property
+    def rule9(self) -> Rule9Params:
+        return Rule9Params(self.restricted_nav_statuses, self.reassess_every_s)
+
+    @property
+    def dimension_defaults(self) -> DimensionDefaults:
+        return DimensionDefaults(
+            self.default_length_m, self.default_breadth_m, self.default_draught_m
+        )
 
     def __post_init__(self) -> None:
         positive = (
@@ -176,3 +199,25 @@ def replay_params_from_table(table: dict[str, Any], where: str) -> ReplayParams:
 
 
 REPLAY_KEYS: tuple[str, ...] = tuple(f.name for f in fields(ReplayParams))
+
+
+@dataclass(frozen=True)
+class ReplayRunParams:
+    """Every parameter of one replay run, as written to run.json."""
+
+    replay: ReplayParams
+    colregs: ColregsParams
+    manoeuvrability: ManoeuvrabilityParams
+    own_mmsi: tuple[int, ...]
+
+    @property
+    def pair(self) -> PairParams:
+        """What the evaluation of each pair reads (``core/pair.py``)."""
+        return PairParams(
+            colregs=self.colregs,
+            manoeuvrability=self.manoeuvrability,
+            encounters=self.replay.encounters,
+            conduct=self.replay.conduct,
+            rule9=self.replay.rule9,
+            dimensions=self.replay.dimension_defaults,
+        )

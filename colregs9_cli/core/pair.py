@@ -1,0 +1,507 @@
+"""One triggered pair, evaluated once, and seen from either seat (docs/design.md §5, Replay).
+
+A pair is evaluated in vessel order (a, b), a with the lower MMSI, whichever seat's run the
+pair search found: ``evaluate_pair`` gives a ``PairEvaluation``. ``PairEvaluation.seen_from``
+gives a ``Seat``: the same evaluation with one vessel as own ship and the other as target,
+and ``Seat.mine`` is the one place where a pair of values (a, b) becomes (own, target).
+
+- **G_a** (``colregs.py``) classifies the pair at the trigger. That situation and both roles
+  are held until the pair is past (rule 13(d)); the time series also records the
+  instantaneous geometry of every step (``situation_now``).
+- **G_d** (``rule9.py``) runs in both seats at every step, and ``decide_pair`` combines them
+  with rules 13 and 18 into the pair's final roles. The verdict is the one at the trigger.
+- **Manoeuvrability** (event d3) is estimated for both vessels at the trigger (it is the
+  verdict and the figure), and later for each vessel that does not report a restricted
+  status, at most every ``reassess_every_s``; otherwise the last estimate is carried
+  forward. The give-way vessel's estimate is G_d's d3; the stand-on vessel's tells whether
+  both are restricted (``rule9.decide_pair``). No chart, or a vessel outside the chart's
+  coverage, gives ``unknown``: ¬d3 for the automaton, recorded as ``unknown``.
+- **Dimensions** a vessel does not report take the defaults of ``vessel_defaults.py`` (by
+  Class A/B and ship type); a verdict in which the estimator's answer for such a vessel
+  entered G_d is flagged ``verdict_rests_on_defaults``.
+- **Audit facts** (``audit.py``) over the pair's data from the trigger: the series follows
+  both tracks past the end of the candidate run, to the pass or for at most TCPA +
+  ``tcpa_act_s`` after the trigger, and stops at the first step where either track stops.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, TypeVar
+
+import numpy as np
+import pandas as pd
+
+from ..charts.water import Chart
+from ..geo import sail
+from .audit import INSUFFICIENT_CONDUCT, Conduct, ConductParams, conduct, passage
+from .colregs import ColregsEvaluation, ColregsParams, Kinematics, Role, evaluate_colregs
+from .encounters import Encounter, EncounterParams, encounter_series
+from .manoeuvrability import (
+    ManoeuvrabilityAssessment,
+    ManoeuvrabilityParams,
+    Restriction,
+    VesselState,
+    assess_manoeuvrability,
+    unplaced_assessment,
+)
+from .rule9 import Finding, PairVerdict, Rule9Assessment, Rule9Params, decide_pair
+from .rule9 import nav_status_finding as _finding
+from .tracks import Tracks
+from .vessel_defaults import DimensionDefaults, VesselDimensions, vessel_dimensions
+
+T = TypeVar("T")
+
+# The series' column prefixes of vessels a and b.
+PREFIXES = ("own_", "target_")
+
+
+@dataclass(frozen=True)
+class PairParams:
+    """Every parameter the evaluation of one pair reads, each stage's own."""
+
+    colregs: ColregsParams
+    manoeuvrability: ManoeuvrabilityParams
+    encounters: EncounterParams
+    conduct: ConductParams
+    rule9: Rule9Params
+    dimensions: DimensionDefaults
+
+
+@dataclass(frozen=True)
+class VesselAtTrigger:
+    """One vessel of a pair: who she is, her state at the trigger and her conduct after it."""
+
+    mmsi: int
+    name: str | None
+    dimensions: VesselDimensions
+    nav_status: int | None
+    course_deg: float
+    speed_kn: float
+    lat_deg: float
+    lon_deg: float
+    lat_deg_at_cpa: float  # predicted at constant velocity from the trigger to TCPA
+    lon_deg_at_cpa: float
+    estimated_restricted: Restriction
+    conduct: Conduct
+    action_before_cpa_s: float | None
+
+
+@dataclass(frozen=True)
+class PairSteps:
+    """Per-step results of one pair in vessel order (a, b): the evaluation behind its rows."""
+
+    series: pd.DataFrame  # from the trigger to the pass, columns own_* = a, target_* = b
+    g_a: ColregsEvaluation
+    held: ColregsEvaluation  # the trigger's situation, repeated
+    verdicts: list[PairVerdict]
+    estimates: tuple[list[Restriction], list[Restriction]]
+    assessed_row: tuple[list[int], list[int]]
+    trigger_assessments: tuple[ManoeuvrabilityAssessment, ManoeuvrabilityAssessment]
+
+
+@dataclass(frozen=True)
+class PairAudit:
+    """The pass and both vessels' conduct up to the closest approach (vessel order a, b)."""
+
+    covers_cpa: bool
+    min_separation_m: float | None
+    cpa_utc: pd.Timestamp | None
+    conducts: tuple[Conduct, Conduct]
+    before_cpa_s: tuple[float | None, float | None]
+
+
+@dataclass(frozen=True)
+class PairEvaluation:
+    """One triggered pair, evaluated once, in vessel order (a, b) with a the lower MMSI.
+
+    ``encounter`` is the candidate run the pair search found (either seat's); ``full`` holds
+    both tracks (``own_*`` = a, ``target_*`` = b) from the run's start to the end of the
+    audit window, ``steps`` the evaluation from the trigger to the pass.
+    """
+
+    encounter: Encounter
+    vessels: tuple[VesselAtTrigger, VesselAtTrigger]
+    steps: PairSteps
+    audit: PairAudit
+    full: pd.DataFrame
+    restricted_nav_statuses: frozenset[int]
+
+    @property
+    def verdict(self) -> PairVerdict:
+        """The pair's verdict at the trigger."""
+        return self.steps.verdicts[0]
+
+    @property
+    def trigger(self) -> pd.Series:
+        return self.steps.series.iloc[0]
+
+    @property
+    def pair_id(self) -> str:
+        a, b = self.vessels
+        return f"{self.encounter.start:%Y%m%dT%H%M%S}-{a.mmsi}+{b.mmsi}"
+
+    @property
+    def verdict_rests_on_defaults(self) -> bool:
+        a, b = self.vessels
+        return rests_on_defaults(
+            self.verdict,
+            (a.dimensions, b.dimensions),
+            (a.estimated_restricted, b.estimated_restricted),
+            (a.nav_status, b.nav_status),
+            self.restricted_nav_statuses,
+        )
+
+    def with_role(self, role: Role) -> list[VesselAtTrigger]:
+        """The vessels whose final role is ``role``, in vessel order."""
+        finals = self.verdict.role_final
+        return [v for v, final in zip(self.vessels, finals, strict=True) if final is role]
+
+    def seen_from(self, mmsi: int) -> Seat:
+        """The pair from the seat of vessel ``mmsi`` (own ship), the other as target."""
+        mmsis = [v.mmsi for v in self.vessels]
+        if mmsi not in mmsis:
+            raise ValueError(f"MMSI {mmsi} is not in pair {self.pair_id}")
+        return Seat(self, mmsis.index(mmsi))
+
+
+@dataclass(frozen=True)
+class Seat:
+    """A pair seen from one vessel: ``own_index`` is 0 when own ship is vessel a, else 1."""
+
+    pair: PairEvaluation
+    own_index: int
+
+    @property
+    def target_index(self) -> int:
+        return 1 - self.own_index
+
+    def mine(self, values: tuple[T, T]) -> tuple[T, T]:
+        """(own, target) from values in vessel order (a, b)."""
+        return values[self.own_index], values[self.target_index]
+
+    @property
+    def own(self) -> VesselAtTrigger:
+        return self.pair.vessels[self.own_index]
+
+    @property
+    def target(self) -> VesselAtTrigger:
+        return self.pair.vessels[self.target_index]
+
+    @property
+    def prefixes(self) -> tuple[str, str]:
+        """The pair series' column prefixes of own ship and target."""
+        return self.mine(PREFIXES)
+
+    def automata(self, verdict: PairVerdict) -> tuple[Rule9Assessment, Rule9Assessment]:
+        """(own ship's G_d about the target, the target's G_d about own ship)."""
+        return self.mine((verdict.seat_a, verdict.seat_b))
+
+    @property
+    def encounter_id(self) -> str:
+        return f"{self.pair.encounter.start:%Y%m%dT%H%M%S}-{self.own.mmsi}-{self.target.mmsi}"
+
+
+def text_or_none(value: Any) -> str | None:
+    return None if value is None or (isinstance(value, float) and math.isnan(value)) else str(value)
+
+
+def _static(vessels: pd.DataFrame, mmsi: int) -> dict[str, Any]:
+    """A vessel's static AIS fields (empty when she sent none)."""
+    if mmsi not in vessels.index:
+        return {}
+    return {name: value for name, value in vessels.loc[mmsi].items() if not _missing(value)}
+
+
+def _missing(value: Any) -> bool:
+    return value is None or (not isinstance(value, str) and bool(pd.isna(value)))
+
+
+def nav_status(value: Any) -> int | None:
+    """A series' navigational status cell as a code, or None."""
+    return None if pd.isna(value) else int(value)
+
+
+def reports_restricted(value: Any, restricted_nav_statuses: frozenset[int]) -> bool:
+    """True when a series' navigational status cell claims restricted manoeuvrability (d2)."""
+    return _finding(nav_status(value), restricted_nav_statuses) is Finding.TRUE
+
+
+@dataclass
+class _Estimator:
+    """A vessel's manoeuvrability estimate, made when needed and carried forward."""
+
+    chart: Chart | None
+    params: ManoeuvrabilityParams
+    dimensions: VesselDimensions
+    reassess_steps: int
+    assessed_row: int = -1
+    assessment: ManoeuvrabilityAssessment | None = None
+
+    def at(self, state: dict[str, np.ndarray], row: int, needed: bool) -> ManoeuvrabilityAssessment:
+        """The estimate for ``row`` of the vessel's state arrays (made anew when due)."""
+        stale = self.assessment is None or row - self.assessed_row >= self.reassess_steps
+        if self.assessment is None or (needed and stale):
+            placed = all(math.isfinite(state[name][row]) for name in ("north_m", "east_m"))
+            if placed and math.isfinite(state["course_deg"][row]):
+                vessel = VesselState(
+                    north_m=float(state["north_m"][row]),
+                    east_m=float(state["east_m"][row]),
+                    course_deg=float(state["course_deg"][row]),
+                    speed_mps=float(state["speed_mps"][row]),
+                )
+                self.assessment = assess_manoeuvrability(
+                    self.chart, vessel, self.dimensions, self.params
+                )
+            else:
+                self.assessment = unplaced_assessment(self.dimensions, self.params)
+            self.assessed_row = row
+        return self.assessment
+
+
+def pair_tracks(tracks: Tracks, mmsis: tuple[int, int]) -> Tracks:
+    """The two vessels' tracks only: ``encounter_series`` then scans two tracks, not all.
+
+    Relies on ``Tracks.samples`` being sorted by MMSI.
+    """
+    vessel = tracks.samples["mmsi"].to_numpy()
+    parts = [
+        tracks.samples.iloc[
+            np.searchsorted(vessel, mmsi, "left") : np.searchsorted(vessel, mmsi, "right")
+        ]
+        for mmsi in mmsis
+    ]
+    return dataclasses.replace(tracks, samples=pd.concat(parts))
+
+
+def _contiguous_rows(steps: np.ndarray) -> int:
+    """How many rows from the first run on consecutive steps (both tracks present)."""
+    gaps = np.flatnonzero(np.diff(steps) != 1)
+    return int(gaps[0]) + 1 if len(gaps) else len(steps)
+
+
+def _state(series: pd.DataFrame, prefix: str) -> dict[str, np.ndarray]:
+    """A vessel's state arrays for the estimator: the chart lives in the local frame, so the
+    arcs start from the grid course."""
+    return {
+        name: series[f"{prefix}{column}"].to_numpy(dtype=float)
+        for name, column in (
+            ("north_m", "north_m"),
+            ("east_m", "east_m"),
+            ("course_deg", "course_grid_deg"),
+            ("speed_mps", "speed_mps"),
+        )
+    }
+
+
+def _held(g_a: ColregsEvaluation) -> ColregsEvaluation:
+    """The trigger's situation and roles held at every step (rule 13(d)); the bearings and
+    closing flags stay those of each step."""
+    rows = len(g_a.situation)
+    return ColregsEvaluation(
+        **{
+            name: np.repeat(getattr(g_a, name)[:1], rows)
+            for name in ("situation", "own_role", "target_role", "own_overtaking", "ambiguous")
+        },
+        basis=np.repeat(g_a.basis[:1], rows),
+        beta_deg=g_a.beta_deg,
+        beta_prime_deg=g_a.beta_prime_deg,
+        closing=g_a.closing,
+    )
+
+
+def _pair_steps(
+    series: pd.DataFrame,
+    dimensions: tuple[VesselDimensions, VesselDimensions],
+    chart: Chart | None,
+    params: PairParams,
+    step_s: float,
+) -> PairSteps:
+    """G_a, the estimates and G_d of both seats at every step of ``series`` (a = own_)."""
+    g_a = evaluate_colregs(
+        *Kinematics.pair_from_series(series),
+        params.colregs,
+        course_judged_above_kn=params.conduct.course_judged_above_kn,
+    )
+    held = _held(g_a)
+    situation = held.situation[0]
+    roles = (held.own_role[0], held.target_role[0])
+    statuses = params.rule9.restricted_nav_statuses
+    reassess = max(1, round(params.rule9.reassess_every_s / step_s))
+    estimators = tuple(
+        _Estimator(chart, params.manoeuvrability, dims, reassess) for dims in dimensions
+    )
+    states = tuple(_state(series, prefix) for prefix in PREFIXES)
+    nav = tuple([nav_status(v) for v in series[f"{p}nav_status"].tolist()] for p in PREFIXES)
+    estimates: tuple[list[Restriction], list[Restriction]] = ([], [])
+    assessed_row: tuple[list[int], list[int]] = ([], [])
+    verdicts: list[PairVerdict] = []
+    cache: dict[tuple[Any, ...], PairVerdict] = {}
+    trigger: list[ManoeuvrabilityAssessment] = []
+    for row in range(len(series)):
+        for vessel in (0, 1):
+            # Every vessel's estimate counts (decide_pair): the give-way vessel's for G_d,
+            # the stand-on vessel's for "both restricted". A reported status makes it moot.
+            needed = _finding(nav[vessel][row], statuses) is not Finding.TRUE
+            assessment = estimators[vessel].at(states[vessel], row, needed=needed)
+            if row == 0:
+                trigger.append(assessment)
+            estimates[vessel].append(assessment.restriction)
+            assessed_row[vessel].append(estimators[vessel].assessed_row)
+        key = (nav[0][row], nav[1][row], estimates[0][row], estimates[1][row])
+        if key not in cache:
+            cache[key] = decide_pair(situation, roles, (key[0], key[1]), (key[2], key[3]), statuses)
+        verdicts.append(cache[key])
+    return PairSteps(
+        series=series,
+        g_a=g_a,
+        held=held,
+        verdicts=verdicts,
+        estimates=estimates,
+        assessed_row=assessed_row,
+        trigger_assessments=(trigger[0], trigger[1]),
+    )
+
+
+def rests_on_defaults(
+    verdict: PairVerdict,
+    dimensions: tuple[VesselDimensions, VesselDimensions],
+    estimates: tuple[Restriction, Restriction],
+    nav_status: tuple[int | None, int | None],
+    restricted_nav_statuses: frozenset[int],
+) -> bool:
+    """True when an estimate made from defaulted dimensions decided the verdict: the other
+    answer about that vessel would give other final roles or another deciding rule. This
+    covers G_d's d3 about the give-way vessel and the stand-on vessel's "clear" that let rule
+    9 choose between them. "Unknown" (off the chart) rests on no dimension."""
+    other_answer = {
+        Restriction.RESTRICTED: Restriction.NOT_RESTRICTED,
+        Restriction.NOT_RESTRICTED: Restriction.RESTRICTED,
+    }
+    for vessel in (0, 1):
+        estimate = estimates[vessel]
+        if estimate not in other_answer or not bool(dimensions[vessel].defaulted):
+            continue
+        changed = list(estimates)
+        changed[vessel] = other_answer[estimate]
+        alternative = decide_pair(
+            verdict.situation,
+            verdict.role_colregs,
+            nav_status,
+            (changed[0], changed[1]),
+            restricted_nav_statuses,
+        )
+        if (alternative.role_final, alternative.deciding_rule) != (
+            verdict.role_final,
+            verdict.deciding_rule,
+        ):
+            return True
+    return False
+
+
+def _audit(window: pd.DataFrame, params: ConductParams, step_s: float) -> PairAudit:
+    seen = passage(window["range_m"].to_numpy(), window["tcpa_s"].to_numpy())
+    if not seen.covers_cpa or seen.cpa_row is None:
+        return PairAudit(
+            False, None, None, (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT), (None, None)
+        )
+    until = window.iloc[: seen.cpa_row + 1]
+    conducts = tuple(
+        conduct(
+            until[f"{prefix}course_deg"].to_numpy(dtype=float),
+            until[f"{prefix}sog_kn"].to_numpy(dtype=float),
+            params,
+        )
+        for prefix in PREFIXES
+    )
+    before = tuple(
+        None if c.action_row is None else (seen.cpa_row - c.action_row) * step_s for c in conducts
+    )
+    return PairAudit(
+        covers_cpa=True,
+        min_separation_m=seen.min_separation_m,
+        cpa_utc=window["timestamp"].iloc[seen.cpa_row],
+        conducts=(conducts[0], conducts[1]),
+        before_cpa_s=(before[0], before[1]),
+    )
+
+
+def evaluate_pair(
+    tracks: Tracks, encounter: Encounter, chart: Chart | None, params: PairParams
+) -> PairEvaluation:
+    """One triggered pair, evaluated once (see the module docstring). ``encounter`` may be
+    either seat's; ``chart`` is in ``tracks.frame``."""
+    if encounter.trigger_step is None or encounter.tcpa_s_at_trigger is None:
+        raise ValueError(f"encounter {encounter.encounter_id} never triggered")
+    a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
+    oriented = dataclasses.replace(encounter, own_mmsi=a, target_mmsi=b)
+    step_s = tracks.step_s
+    horizon = math.ceil((encounter.tcpa_s_at_trigger + params.encounters.tcpa_act_s) / step_s)
+    full = encounter_series(
+        pair_tracks(tracks, (a, b)),
+        oriented,
+        to_step=max(encounter.end_step, encounter.trigger_step + horizon),
+    )
+    full = full.iloc[: _contiguous_rows(full["step"].to_numpy())].reset_index(drop=True)
+    window = full[full["step"] >= encounter.trigger_step].reset_index(drop=True)
+    audit = _audit(window, params.conduct, step_s)
+    # G_a and G_d run until the pair is past: to the pass, the first step at which it opens,
+    # which is also the last step the audit looks at (its closest approach may lie there).
+    opening = np.flatnonzero(window["tcpa_s"].to_numpy()[1:] < 0.0)
+    series = window.iloc[: int(opening[0]) + 2 if len(opening) else len(window)]
+    dimensions = (
+        vessel_dimensions(_static(tracks.vessels, a), params.dimensions),
+        vessel_dimensions(_static(tracks.vessels, b), params.dimensions),
+    )
+    steps = _pair_steps(series, dimensions, chart, params, step_s)
+    trigger = series.iloc[0]
+    vessels = tuple(
+        _vessel_at_trigger(tracks, mmsi, prefix, trigger, dimensions[i], steps, audit, i)
+        for i, (mmsi, prefix) in enumerate(zip((a, b), PREFIXES, strict=True))
+    )
+    return PairEvaluation(
+        encounter=encounter,
+        vessels=(vessels[0], vessels[1]),
+        steps=steps,
+        audit=audit,
+        full=full,
+        restricted_nav_statuses=params.rule9.restricted_nav_statuses,
+    )
+
+
+def _vessel_at_trigger(
+    tracks: Tracks,
+    mmsi: int,
+    prefix: str,
+    trigger: pd.Series,
+    dimensions: VesselDimensions,
+    steps: PairSteps,
+    audit: PairAudit,
+    index: int,
+) -> VesselAtTrigger:
+    name = (
+        text_or_none(tracks.vessels["name"].get(mmsi)) if "name" in tracks.vessels.columns else None
+    )
+    at_cpa = sail(
+        trigger[f"{prefix}lat_deg"],
+        trigger[f"{prefix}lon_deg"],
+        trigger[f"{prefix}cog_deg"],
+        trigger[f"{prefix}speed_mps"] * trigger["tcpa_s"],
+    )
+    return VesselAtTrigger(
+        mmsi=mmsi,
+        name=name,
+        dimensions=dimensions,
+        nav_status=nav_status(trigger[f"{prefix}nav_status"]),
+        course_deg=float(trigger[f"{prefix}course_deg"]),
+        speed_kn=float(trigger[f"{prefix}sog_kn"]),
+        lat_deg=float(trigger[f"{prefix}lat_deg"]),
+        lon_deg=float(trigger[f"{prefix}lon_deg"]),
+        lat_deg_at_cpa=float(at_cpa[0]),
+        lon_deg_at_cpa=float(at_cpa[1]),
+        estimated_restricted=steps.estimates[index][0],
+        conduct=audit.conducts[index],
+        action_before_cpa_s=audit.before_cpa_s[index],
+    )

@@ -1,0 +1,412 @@
+"""The rows of pairs.csv and encounters.csv and the columns of each seat's time series: each a
+projection of the pair model (``pair.py``), so that a new column is its field and one line in
+its projection, here.
+
+``PairSummary`` is the pair in vessel order (a, b); ``EncounterSummary`` and the series are
+one ``Seat`` of it (own ship, target). Everything about the pair (situation, final roles,
+audit facts) is the same in both seats' rows, seen from either side.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import pandas as pd
+
+from .audit import Action, Fact, all_of, negated
+from .colregs import Role, Situation, SituationBasis
+from .manoeuvrability import Restriction
+from .pair import PairEvaluation, Seat, reports_restricted
+from .rule9 import DecidingRule
+
+
+@dataclass(frozen=True)
+class PairSummary:
+    """One row of pairs.csv: the pair-level verdict; vessel a has the lower MMSI."""
+
+    pair_id: str
+    mmsi_a: int
+    mmsi_b: int
+    name_a: str | None
+    name_b: str | None
+    seats_reported: str
+    start_utc: pd.Timestamp
+    trigger_utc: pd.Timestamp
+    end_utc: pd.Timestamp
+    situation: Situation
+    situation_ambiguous: bool
+    situation_basis: SituationBasis
+    role_colregs_a: Role
+    role_colregs_b: Role
+    nav_status_a: int | None
+    nav_status_b: int | None
+    estimated_restricted_a: Restriction
+    estimated_restricted_b: Restriction
+    automaton_path_a: str
+    automaton_path_b: str
+    rule9_applied: bool
+    deciding_rule: DecidingRule
+    both_restricted: bool
+    role_final_a: Role
+    role_final_b: Role
+    give_way_vessels: str
+    verdict_rests_on_defaults: bool
+    range_m_at_trigger: float
+    cpa_m: float
+    tcpa_s: float
+    lat_deg_at_trigger_a: float
+    lon_deg_at_trigger_a: float
+    lat_deg_at_trigger_b: float
+    lon_deg_at_trigger_b: float
+    lat_deg_at_cpa_a: float
+    lon_deg_at_cpa_a: float
+    lat_deg_at_cpa_b: float
+    lon_deg_at_cpa_b: float
+    data_covers_cpa: bool
+    actual_min_separation_m: float | None
+    actual_min_separation_utc: pd.Timestamp | None
+    give_way_vessel_acted: Fact | None
+    give_way_action: str
+    action_before_cpa_s: str
+    stand_on_vessel_kept_course: Fact | None
+    action_a: Action
+    action_b: Action
+    length_m_a: float
+    breadth_m_a: float
+    draught_m_a: float
+    defaulted_dimensions_a: str
+    length_m_b: float
+    breadth_m_b: float
+    draught_m_b: float
+    defaulted_dimensions_b: str
+
+
+PAIR_COLUMNS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(PairSummary))
+
+
+@dataclass(frozen=True)
+class EncounterSummary:
+    """One row of encounters.csv (one seat of a pair); the field order is the column order.
+
+    ``automaton_path`` is this seat's G_d (own ship asks about the target) and
+    ``target_seat_automaton_path`` the other seat's (the target asks about own ship).
+    Everything about the pair (situation, final roles, audit facts) is the same in both
+    seats' rows, seen from the other side.
+    """
+
+    encounter_id: str
+    pair_id: str
+    own_mmsi: int
+    target_mmsi: int
+    own_name: str | None
+    target_name: str | None
+    start_utc: pd.Timestamp
+    trigger_utc: pd.Timestamp
+    end_utc: pd.Timestamp
+    situation: Situation
+    situation_ambiguous: bool
+    situation_basis: SituationBasis
+    own_role_colregs: Role
+    target_role_colregs: Role
+    own_nav_status: int | None
+    target_nav_status: int | None
+    target_reports_restricted: bool
+    target_estimated_restricted: Restriction
+    own_estimated_restricted: Restriction
+    automaton_path: str
+    target_seat_automaton_path: str
+    rule9_applied: bool
+    deciding_rule: DecidingRule
+    both_restricted: bool
+    own_role_final: Role
+    target_role_final: Role
+    give_way_vessel: str
+    give_way_vessels: str
+    verdict_rests_on_defaults: bool
+    range_m_at_trigger: float
+    cpa_m: float
+    tcpa_s: float
+    own_lat_deg_at_trigger: float
+    own_lon_deg_at_trigger: float
+    target_lat_deg_at_trigger: float
+    target_lon_deg_at_trigger: float
+    own_lat_deg_at_cpa: float
+    own_lon_deg_at_cpa: float
+    target_lat_deg_at_cpa: float
+    target_lon_deg_at_cpa: float
+    data_covers_cpa: bool
+    actual_min_separation_m: float | None
+    actual_min_separation_utc: pd.Timestamp | None
+    give_way_vessel_acted: Fact | None
+    give_way_action: str
+    action_before_cpa_s: str
+    stand_on_vessel_kept_course: Fact | None
+    own_course_deg_at_trigger: float
+    own_speed_kn_at_trigger: float
+    target_course_deg_at_trigger: float
+    target_speed_kn_at_trigger: float
+    own_length_m: float
+    own_breadth_m: float
+    own_draught_m: float
+    own_dimensions_defaulted: str
+    target_length_m: float
+    target_breadth_m: float
+    target_draught_m: float
+    target_dimensions_defaulted: str
+
+
+ENCOUNTER_COLUMNS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(EncounterSummary))
+
+# Per-vessel columns of a time series; each seat's series has them as own_* and target_*.
+SERIES_VESSEL_FIELDS: tuple[str, ...] = (
+    "lat_deg",
+    "lon_deg",
+    "north_m",
+    "east_m",
+    "cog_deg",
+    "heading_deg",
+    "course_deg",
+    "sog_kn",
+    "nav_status",
+)
+SERIES_COLUMNS: tuple[str, ...] = (
+    "step",
+    "timestamp",
+    *(f"own_{name}" for name in SERIES_VESSEL_FIELDS),
+    *(f"target_{name}" for name in SERIES_VESSEL_FIELDS),
+    "range_m",
+    "cpa_m",
+    "tcpa_s",
+    "beta_deg",
+    "beta_prime_deg",
+    "situation_now",
+    "situation_now_ambiguous",
+    "situation",
+    "own_role_colregs",
+    "target_role_colregs",
+    "own_reports_restricted",
+    "target_reports_restricted",
+    "own_estimated_restricted",
+    "target_estimated_restricted",
+    "own_assessed_utc",
+    "target_assessed_utc",
+    "automaton_state",
+    "automaton_path",
+    "target_seat_automaton_path",
+    "rule9_applied",
+    "deciding_rule",
+    "own_role_final",
+    "target_role_final",
+)
+
+
+def _mmsi_list(mmsis: Sequence[int]) -> str:
+    return ";".join(str(m) for m in mmsis)
+
+
+def _joined(values: Sequence[Any]) -> str:
+    return ";".join(str(v) for v in values)
+
+
+def _seconds(value: float | None) -> str:
+    return "" if value is None else f"{value:g}"
+
+
+def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
+    """The pairs.csv row of ``pair``; ``seats``: the own-ship MMSIs reported."""
+    verdict = pair.verdict
+    trigger = pair.trigger
+    held = pair.steps.held
+    a, b = pair.vessels
+    give_way = pair.with_role(Role.GIVE_WAY)
+    stand_on = pair.with_role(Role.STAND_ON)
+    return PairSummary(
+        pair_id=pair.pair_id,
+        mmsi_a=a.mmsi,
+        mmsi_b=b.mmsi,
+        name_a=a.name,
+        name_b=b.name,
+        seats_reported=_mmsi_list(sorted(set(seats))),
+        start_utc=pair.encounter.start,
+        trigger_utc=trigger["timestamp"],
+        end_utc=pair.encounter.end,
+        situation=verdict.situation,
+        situation_ambiguous=bool(held.ambiguous[0]),
+        situation_basis=held.basis[0],
+        role_colregs_a=verdict.role_colregs[0],
+        role_colregs_b=verdict.role_colregs[1],
+        nav_status_a=a.nav_status,
+        nav_status_b=b.nav_status,
+        estimated_restricted_a=a.estimated_restricted,
+        estimated_restricted_b=b.estimated_restricted,
+        automaton_path_a=verdict.seat_a.path_text,
+        automaton_path_b=verdict.seat_b.path_text,
+        rule9_applied=verdict.rule9_applied,
+        deciding_rule=verdict.deciding_rule,
+        both_restricted=verdict.both_restricted,
+        role_final_a=verdict.role_final[0],
+        role_final_b=verdict.role_final[1],
+        give_way_vessels=_mmsi_list([v.mmsi for v in give_way]),
+        verdict_rests_on_defaults=pair.verdict_rests_on_defaults,
+        range_m_at_trigger=float(trigger["range_m"]),
+        cpa_m=float(trigger["cpa_m"]),
+        tcpa_s=float(trigger["tcpa_s"]),
+        lat_deg_at_trigger_a=a.lat_deg,
+        lon_deg_at_trigger_a=a.lon_deg,
+        lat_deg_at_trigger_b=b.lat_deg,
+        lon_deg_at_trigger_b=b.lon_deg,
+        lat_deg_at_cpa_a=a.lat_deg_at_cpa,
+        lon_deg_at_cpa_a=a.lon_deg_at_cpa,
+        lat_deg_at_cpa_b=b.lat_deg_at_cpa,
+        lon_deg_at_cpa_b=b.lon_deg_at_cpa,
+        data_covers_cpa=pair.audit.covers_cpa,
+        actual_min_separation_m=pair.audit.min_separation_m,
+        actual_min_separation_utc=pair.audit.cpa_utc,
+        give_way_vessel_acted=all_of(v.conduct.changed for v in give_way) if give_way else None,
+        give_way_action=_joined([v.conduct.action.value for v in give_way]),
+        action_before_cpa_s=_joined([_seconds(v.action_before_cpa_s) for v in give_way]),
+        stand_on_vessel_kept_course=(
+            all_of(negated(v.conduct.changed) for v in stand_on) if stand_on else None
+        ),
+        action_a=a.conduct.action,
+        action_b=b.conduct.action,
+        length_m_a=a.dimensions.length_m,
+        breadth_m_a=a.dimensions.breadth_m,
+        draught_m_a=a.dimensions.draught_m,
+        defaulted_dimensions_a=a.dimensions.defaulted_text,
+        length_m_b=b.dimensions.length_m,
+        breadth_m_b=b.dimensions.breadth_m,
+        draught_m_b=b.dimensions.draught_m,
+        defaulted_dimensions_b=b.dimensions.defaulted_text,
+    )
+
+
+def _give_way_side(own_role: Role, target_role: Role) -> str:
+    sides = [
+        side for side, role in (("own", own_role), ("target", target_role)) if role is Role.GIVE_WAY
+    ]
+    return "+".join(sides) if sides else "none"
+
+
+def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
+    """The encounters.csv row of one seat; ``pair`` is the pair's row (``pair_row``)."""
+    verdict = seat.pair.verdict
+    own, target = seat.own, seat.target
+    own_automaton, target_automaton = seat.automata(verdict)
+    own_colregs, target_colregs = seat.mine(verdict.role_colregs)
+    own_final, target_final = seat.mine(verdict.role_final)
+    return EncounterSummary(
+        encounter_id=seat.encounter_id,
+        pair_id=pair.pair_id,
+        own_mmsi=own.mmsi,
+        target_mmsi=target.mmsi,
+        own_name=own.name,
+        target_name=target.name,
+        start_utc=pair.start_utc,
+        trigger_utc=pair.trigger_utc,
+        end_utc=pair.end_utc,
+        situation=pair.situation,
+        situation_ambiguous=pair.situation_ambiguous,
+        situation_basis=pair.situation_basis,
+        own_role_colregs=own_colregs,
+        target_role_colregs=target_colregs,
+        own_nav_status=own.nav_status,
+        target_nav_status=target.nav_status,
+        target_reports_restricted=reports_restricted(
+            target.nav_status, seat.pair.restricted_nav_statuses
+        ),
+        target_estimated_restricted=target.estimated_restricted,
+        own_estimated_restricted=own.estimated_restricted,
+        automaton_path=own_automaton.path_text,
+        target_seat_automaton_path=target_automaton.path_text,
+        rule9_applied=pair.rule9_applied,
+        deciding_rule=pair.deciding_rule,
+        both_restricted=pair.both_restricted,
+        own_role_final=own_final,
+        target_role_final=target_final,
+        give_way_vessel=_give_way_side(own_final, target_final),
+        give_way_vessels=pair.give_way_vessels,
+        verdict_rests_on_defaults=pair.verdict_rests_on_defaults,
+        range_m_at_trigger=pair.range_m_at_trigger,
+        cpa_m=pair.cpa_m,
+        tcpa_s=pair.tcpa_s,
+        own_lat_deg_at_trigger=own.lat_deg,
+        own_lon_deg_at_trigger=own.lon_deg,
+        target_lat_deg_at_trigger=target.lat_deg,
+        target_lon_deg_at_trigger=target.lon_deg,
+        own_lat_deg_at_cpa=own.lat_deg_at_cpa,
+        own_lon_deg_at_cpa=own.lon_deg_at_cpa,
+        target_lat_deg_at_cpa=target.lat_deg_at_cpa,
+        target_lon_deg_at_cpa=target.lon_deg_at_cpa,
+        data_covers_cpa=pair.data_covers_cpa,
+        actual_min_separation_m=pair.actual_min_separation_m,
+        actual_min_separation_utc=pair.actual_min_separation_utc,
+        give_way_vessel_acted=pair.give_way_vessel_acted,
+        give_way_action=pair.give_way_action,
+        action_before_cpa_s=pair.action_before_cpa_s,
+        stand_on_vessel_kept_course=pair.stand_on_vessel_kept_course,
+        own_course_deg_at_trigger=own.course_deg,
+        own_speed_kn_at_trigger=own.speed_kn,
+        target_course_deg_at_trigger=target.course_deg,
+        target_speed_kn_at_trigger=target.speed_kn,
+        own_length_m=own.dimensions.length_m,
+        own_breadth_m=own.dimensions.breadth_m,
+        own_draught_m=own.dimensions.draught_m,
+        own_dimensions_defaulted=own.dimensions.defaulted_text,
+        target_length_m=target.dimensions.length_m,
+        target_breadth_m=target.dimensions.breadth_m,
+        target_draught_m=target.dimensions.draught_m,
+        target_dimensions_defaulted=target.dimensions.defaulted_text,
+    )
+
+
+def seat_series(seat: Seat) -> pd.DataFrame:
+    """The time series of one seat (``SERIES_COLUMNS``), from the trigger to the pass."""
+    steps = seat.pair.steps
+    series = steps.series
+    statuses = seat.pair.restricted_nav_statuses
+    timestamps = series["timestamp"].tolist()
+    columns: dict[str, Any] = {
+        "step": series["step"].to_numpy(),
+        "timestamp": series["timestamp"].to_numpy(),
+    }
+    own_prefix, target_prefix = seat.prefixes
+    for name in SERIES_VESSEL_FIELDS:
+        columns[f"own_{name}"] = series[f"{own_prefix}{name}"].to_numpy()
+        columns[f"target_{name}"] = series[f"{target_prefix}{name}"].to_numpy()
+    for name in ("range_m", "cpa_m", "tcpa_s"):
+        columns[name] = series[name].to_numpy()
+    # beta is the bearing of the target from own ship, beta' of own ship from the target.
+    columns["beta_deg"], columns["beta_prime_deg"] = seat.mine(
+        (steps.g_a.beta_deg, steps.g_a.beta_prime_deg)
+    )
+    own_roles, target_roles = seat.mine((steps.held.own_role, steps.held.target_role))
+    columns |= {
+        "situation_now": [s.value for s in steps.g_a.situation],
+        "situation_now_ambiguous": steps.g_a.ambiguous,
+        "situation": [s.value for s in steps.held.situation],
+        "own_role_colregs": [r.value for r in own_roles],
+        "target_role_colregs": [r.value for r in target_roles],
+    }
+    for prefix, vessel, source in zip(
+        ("own_", "target_"), seat.mine((0, 1)), seat.prefixes, strict=True
+    ):
+        columns[f"{prefix}reports_restricted"] = [
+            reports_restricted(v, statuses) for v in series[f"{source}nav_status"].tolist()
+        ]
+        columns[f"{prefix}estimated_restricted"] = [e.value for e in steps.estimates[vessel]]
+        columns[f"{prefix}assessed_utc"] = [timestamps[r] for r in steps.assessed_row[vessel]]
+    automata = [seat.automata(v) for v in steps.verdicts]
+    columns |= {
+        "automaton_state": [own.final_state.value for own, _ in automata],
+        "automaton_path": [own.path_text for own, _ in automata],
+        "target_seat_automaton_path": [other.path_text for _, other in automata],
+        "rule9_applied": [v.rule9_applied for v in steps.verdicts],
+        "deciding_rule": [v.deciding_rule.value for v in steps.verdicts],
+        "own_role_final": [seat.mine(v.role_final)[0].value for v in steps.verdicts],
+        "target_role_final": [seat.mine(v.role_final)[1].value for v in steps.verdicts],
+    }
+    return pd.DataFrame(columns)[list(SERIES_COLUMNS)]
