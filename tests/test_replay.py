@@ -29,6 +29,7 @@ from colregs9_cli.core.manoeuvrability import (
     target_rate_of_swing_deg_per_m,
     verdict,
 )
+from colregs9_cli.core.passing import opening_threshold_m
 from colregs9_cli.core.rows import ENCOUNTER_COLUMNS, PAIR_COLUMNS
 from colregs9_cli.errors import ParameterError
 from colregs9_cli.jobs.replay import run_params, run_replay
@@ -177,8 +178,9 @@ def test_no_audit_fact_is_judged_on_data_that_stops(national) -> None:
     table = _encounters(national)
     stops = ~table["data_covers_cpa"]
     assert stops.any() and (~stops).any()
-    assert table.loc[stops, "actual_min_separation_m"].isna().all()
-    assert table.loc[stops, "actual_min_separation_utc"].isna().all()
+    # The least range so far is observed; the closest approach may lie past the data.
+    stopped = table[stops]
+    assert (stopped["actual_min_separation_m"] <= stopped["range_m_at_trigger"] + 1e-6).all()
     for column in ("give_way_vessel_acted", "stand_on_vessel_kept_course"):
         judged = table.loc[stops, column].dropna()
         assert (judged == "insufficient-data").all(), column
@@ -237,12 +239,18 @@ def test_national_time_series_runs_from_the_trigger_until_the_pass(national) -> 
         series = outcome.series
         summary = outcome.summary
         assert series["timestamp"].iloc[0] == summary.trigger_utc
-        # closing at every step but the last, which is the pass when the data reach it
-        assert (series["tcpa_s"].iloc[:-1] >= 0.0).all()
-        assert (series["tcpa_s"].iloc[-1] < 0.0) == summary.data_covers_cpa
+        # to the pass: the first step at which the range has opened clearly past its least
+        # value so far (core/passing.py), when the data reach it
+        ranges = series["range_m"].to_numpy()
+        least = np.minimum.accumulate(ranges)
+        opened = ranges > opening_threshold_m(least, national.params.passing)
+        assert not opened[:-1].any()
+        assert opened[-1] == summary.data_covers_cpa
         assert (np.diff(series["step"]) == 1).all()
-        horizon = pd.Timedelta(seconds=summary.tcpa_s + national.params.encounters.tcpa_act_s + 1)
-        assert series["timestamp"].iloc[-1] <= summary.trigger_utc + horizon
+        follow_s = summary.tcpa_s + national.params.passing.follow_s + 1
+        assert series["timestamp"].iloc[-1] <= summary.trigger_utc + pd.Timedelta(seconds=follow_s)
+        if summary.actual_min_separation_m is not None:
+            assert summary.actual_min_separation_m == pytest.approx(ranges.min())
         assert series["automaton_path"].iloc[0] == summary.automaton_path
         # the situation is held from the trigger; the instantaneous one may change
         assert (series["situation"] == summary.situation.value).all()
@@ -517,7 +525,8 @@ def test_crossing_with_a_target_reporting_status_3_goes_d1_d2_d4(
 def test_tracks_that_stop_before_cpa_give_insufficient_data(tmp_path: Path) -> None:
     table = _head_on(tmp_path, duration_s=200.0)
     assert not table["data_covers_cpa"].any()
-    assert table["actual_min_separation_m"].isna().all()
+    # the least range seen before the data stop, not the closest approach
+    assert (table["actual_min_separation_m"] > table["cpa_m"]).all()
     assert (table["give_way_vessel_acted"] == "insufficient-data").all()
     assert (table["give_way_action"] == "insufficient-data").all()
     # the verdict itself stands: it is made at the trigger

@@ -69,7 +69,9 @@ def test_small_craft_take_small_craft_dimensions(sandiego) -> None:
 def test_no_audit_fact_on_data_that_stops(sandiego) -> None:
     pairs = _table(sandiego, "pairs.csv")
     stops = pairs["data_covers_cpa"] == "false"
-    assert (pairs.loc[stops, "actual_min_separation_m"] == "").all()
+    # the least range seen so far is reported, never below the range the data end with
+    seen = pairs.loc[stops, "actual_min_separation_m"].astype(float)
+    assert (seen <= pairs.loc[stops, "range_m_at_trigger"].astype(float) + 1e-6).all()
     for column in ("give_way_vessel_acted", "stand_on_vessel_kept_course"):
         assert set(pairs.loc[stops, column]) <= {"insufficient-data", ""}, column
     covered = pairs[~stops]

@@ -19,9 +19,10 @@ and ``Seat.mine`` is the one place where a pair of values (a, b) becomes (own, t
 - **Dimensions** a vessel does not report take the defaults of ``vessel_defaults.py`` (by
   Class A/B and ship type); a verdict in which the estimator's answer for such a vessel
   entered G_d is flagged ``verdict_rests_on_defaults``.
-- **Audit facts** (``audit.py``) over the pair's data from the trigger: the series follows
-  both tracks past the end of the candidate run, to the pass or for at most TCPA +
-  ``tcpa_act_s`` after the trigger, and stops at the first step where either track stops.
+- **The passing** (``passing.py``): from the trigger until the range has opened clearly past
+  its least value, following both tracks past the end of the candidate run for at most TCPA
+  + ``passing_follow_s``, and stopping at the first step where either track stops. G_a and
+  G_d run to its end; the audit facts (``audit.py``) are judged up to its closest approach.
 """
 
 from __future__ import annotations
@@ -36,7 +37,7 @@ import pandas as pd
 
 from ..charts.water import Chart
 from ..geo import sail
-from .audit import INSUFFICIENT_CONDUCT, Conduct, ConductParams, conduct, passage
+from .audit import INSUFFICIENT_CONDUCT, Conduct, ConductParams, conduct
 from .colregs import ColregsEvaluation, ColregsParams, Kinematics, Role, evaluate_colregs
 from .encounters import Encounter, EncounterParams, encounter_series
 from .manoeuvrability import (
@@ -47,6 +48,7 @@ from .manoeuvrability import (
     assess_manoeuvrability,
     unplaced_assessment,
 )
+from .passing import Passing, PassingParams, horizon_steps, passing
 from .rule9 import Finding, PairVerdict, Rule9Assessment, Rule9Params, decide_pair
 from .rule9 import nav_status_finding as _finding
 from .tracks import Tracks
@@ -68,6 +70,7 @@ class PairParams:
     conduct: ConductParams
     rule9: Rule9Params
     dimensions: DimensionDefaults
+    passing: PassingParams
 
 
 @dataclass(frozen=True)
@@ -401,11 +404,21 @@ def rests_on_defaults(
     return False
 
 
-def _audit(window: pd.DataFrame, params: ConductParams, step_s: float) -> PairAudit:
-    seen = passage(window["range_m"].to_numpy(), window["tcpa_s"].to_numpy())
-    if not seen.covers_cpa or seen.cpa_row is None:
+def _audit(window: pd.DataFrame, seen: Passing, params: ConductParams, step_s: float) -> PairAudit:
+    if seen.cpa_row is None:
         return PairAudit(
             False, None, None, (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT), (None, None)
+        )
+    cpa_utc = window["timestamp"].iloc[seen.cpa_row]
+    if not seen.covers_cpa:
+        # The least range so far is observed, but the closest approach may lie past the data:
+        # what the vessels did before it cannot be judged.
+        return PairAudit(
+            False,
+            seen.min_separation_m,
+            cpa_utc,
+            (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT),
+            (None, None),
         )
     until = window.iloc[: seen.cpa_row + 1]
     conducts = tuple(
@@ -422,7 +435,7 @@ def _audit(window: pd.DataFrame, params: ConductParams, step_s: float) -> PairAu
     return PairAudit(
         covers_cpa=True,
         min_separation_m=seen.min_separation_m,
-        cpa_utc=window["timestamp"].iloc[seen.cpa_row],
+        cpa_utc=cpa_utc,
         conducts=(conducts[0], conducts[1]),
         before_cpa_s=(before[0], before[1]),
     )
@@ -438,7 +451,7 @@ def evaluate_pair(
     a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
     oriented = dataclasses.replace(encounter, own_mmsi=a, target_mmsi=b)
     step_s = tracks.step_s
-    horizon = math.ceil((encounter.tcpa_s_at_trigger + params.encounters.tcpa_act_s) / step_s)
+    horizon = horizon_steps(encounter.tcpa_s_at_trigger, params.passing, step_s)
     full = encounter_series(
         pair_tracks(tracks, (a, b)),
         oriented,
@@ -446,11 +459,11 @@ def evaluate_pair(
     )
     full = full.iloc[: _contiguous_rows(full["step"].to_numpy())].reset_index(drop=True)
     window = full[full["step"] >= encounter.trigger_step].reset_index(drop=True)
-    audit = _audit(window, params.conduct, step_s)
-    # G_a and G_d run until the pair is past: to the pass, the first step at which it opens,
-    # which is also the last step the audit looks at (its closest approach may lie there).
-    opening = np.flatnonzero(window["tcpa_s"].to_numpy()[1:] < 0.0)
-    series = window.iloc[: int(opening[0]) + 2 if len(opening) else len(window)]
+    seen = passing(window["range_m"].to_numpy(), params.passing)
+    audit = _audit(window, seen, params.conduct, step_s)
+    # G_a and G_d run until the pair is past: until the range has opened clearly past its
+    # least value (core/passing.py), or the data ends.
+    series = window.iloc[: seen.end_row + 1]
     dimensions = (
         vessel_dimensions(_static(tracks.vessels, a), params.dimensions),
         vessel_dimensions(_static(tracks.vessels, b), params.dimensions),

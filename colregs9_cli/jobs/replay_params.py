@@ -22,6 +22,7 @@ from ..core.colregs import ColregsParams
 from ..core.encounters import EncounterParams
 from ..core.manoeuvrability import ManoeuvrabilityParams
 from ..core.pair import PairParams
+from ..core.passing import PassingParams
 from ..core.rule9 import Rule9Params
 from ..core.tracks import TrackParams
 from ..core.vessel_defaults import DimensionDefaults
@@ -89,6 +90,9 @@ class ReplayParams:
     default_breadth_m: float | None = None
     default_draught_m: float | None = None
     slab_s: float = 1800.0
+    passing_open_m: float = 100.0
+    passing_open_frac: float = 0.5
+    passing_follow_s: float = 600.0
 
     @property
     def tracks(self) -> TrackParams:
@@ -110,6 +114,10 @@ class ReplayParams:
         )
 
     @property
+    def passing(self) -> PassingParams:
+        return PassingParams(self.passing_open_m, self.passing_open_frac, self.passing_follow_s)
+
+    @property
     def rule9(self) -> Rule9Params:
         return Rule9Params(self.restricted_nav_statuses, self.reassess_every_s)
 
@@ -129,6 +137,8 @@ class ReplayParams:
             "course_change_deg",
             "speed_change_frac",
             "reassess_every_s",
+            "passing_open_m",
+            "passing_follow_s",
         )  # slab_s: its range below names --slab-minutes
         for name in positive:
             value = getattr(self, name)
@@ -141,7 +151,13 @@ class ReplayParams:
                     f"[replay] {name} = {value!r}: give a positive number, or leave it out to "
                     "take defaults by ship type"
                 )
-        for name in ("min_sog_kn", "tcpa_act_s", "course_judged_above_kn", "speed_change_min_kn"):
+        for name in (
+            "min_sog_kn",
+            "tcpa_act_s",
+            "course_judged_above_kn",
+            "speed_change_min_kn",
+            "passing_open_frac",
+        ):
             value = getattr(self, name)
             if not (math.isfinite(value) and value >= 0.0):
                 raise ParameterError(f"[replay] {name} = {value!r}: give a number >= 0")
@@ -167,7 +183,7 @@ class ReplayParams:
                 "that (2 nm, 3704 m, is the default)"
             )
         window_steps = (
-            self.slab_s + 2.0 * self.tcpa_act_s + 60.0 + 4.0 * self.max_gap_s
+            self.slab_s + self.tcpa_act_s + self.passing_follow_s + 60.0 + 4.0 * self.max_gap_s
         ) / self.step_s
         if window_steps > MAX_STEPS_PER_SLAB:
             raise ParameterError(
@@ -220,4 +236,5 @@ class ReplayRunParams:
             conduct=self.replay.conduct,
             rule9=self.replay.rule9,
             dimensions=self.replay.dimension_defaults,
+            passing=self.replay.passing,
         )

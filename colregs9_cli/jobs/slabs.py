@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 
 from ..charts.water import Chart
 from ..core.encounters import Encounter, find_encounters
+from ..core.passing import horizon_steps
 from ..core.replay_results import PairOutcome
 from ..core.tracks import (
     KEPT_COLUMNS,
@@ -352,9 +353,9 @@ class SlabResult:
 
 
 def tail_steps(params: ReplayParams) -> int:
-    """How far past its core a slab's window reaches: two TCPA_act (a trigger at the end of
-    the core, its TCPA and the pass after it) and a minute."""
-    return math.ceil((2.0 * params.tcpa_act_s + 60.0) / params.step_s)
+    """How far past its core a slab's window reaches: a trigger at the end of the core, its
+    TCPA (at most TCPA_act), the passing followed past it, and a minute."""
+    return math.ceil((params.tcpa_act_s + params.passing_follow_s + 60.0) / params.step_s)
 
 
 def _tracks(job: SlabContext, steps: tuple[int, int], mmsis: Sequence[int] | None) -> Tracks:
@@ -381,7 +382,7 @@ def _last_needed_step(encounter: Encounter, params: ReplayParams) -> int:
     """The last step the encounter's evaluation reads (``replay.evaluate_pair``)."""
     if encounter.trigger_step is None or encounter.tcpa_s_at_trigger is None:
         return encounter.end_step
-    horizon = math.ceil((encounter.tcpa_s_at_trigger + params.tcpa_act_s) / params.step_s)
+    horizon = horizon_steps(encounter.tcpa_s_at_trigger, params.passing, params.step_s)
     return max(encounter.end_step, encounter.trigger_step + horizon)
 
 
