@@ -2,18 +2,27 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from colregs9_cli.core.audit import (
     Action,
     ConductParams,
     Fact,
+    action_as_rule_asks,
     all_of,
     conduct,
     negated,
-    passage,
+    stand_on_turned_to_port_for_vessel_on_port,
 )
+from colregs9_cli.core.colregs import Role, Situation
+from colregs9_cli.core.rule9 import DecidingRule
+from colregs9_cli.errors import ParameterError
 
 PARAMS = ConductParams(
     course_change_deg=15.0,
@@ -21,21 +30,6 @@ PARAMS = ConductParams(
     speed_change_min_kn=1.0,
     course_judged_above_kn=2.0,
 )
-
-
-def test_passage_is_the_first_opening_step_and_the_least_range_before_it() -> None:
-    seen = passage([500.0, 300.0, 120.0, 90.0, 100.0, 200.0], [60, 40, 20, 2, -3, -20])
-    assert seen.covers_cpa and seen.cpa_row == 3 and seen.min_separation_m == 90.0
-
-
-def test_data_that_stops_before_the_pass_covers_nothing() -> None:
-    seen = passage([500.0, 300.0, 120.0], [60.0, 40.0, 20.0])
-    assert not seen.covers_cpa
-    assert seen.cpa_row is None and seen.min_separation_m is None
-
-
-def test_the_trigger_row_itself_never_counts_as_the_pass() -> None:
-    assert not passage([100.0, 90.0], [-1.0, 5.0]).covers_cpa
 
 
 @pytest.mark.parametrize(
@@ -86,3 +80,267 @@ def test_three_valued_logic() -> None:
     assert all_of([Fact.INSUFFICIENT, Fact.FALSE]) is Fact.FALSE
     assert negated(Fact.TRUE) is Fact.FALSE and negated(Fact.FALSE) is Fact.TRUE
     assert negated(Fact.INSUFFICIENT) is Fact.INSUFFICIENT
+
+
+# --- the kinds of action: stopped ------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("speed_kn", "action", "row"),
+    [
+        ([10.0, 8.0, 5.0, 0.3], Action.STOPPED, 2),  # the row is where the slowing began
+        ([10.0, 8.0, 5.0, 0.5], Action.SLOWED, 2),  # 0.5 kn is not below 0.5 kn
+        ([10.0, 6.0, 0.2, 3.0], Action.STOPPED, 1),  # stopped, then under way again
+        ([6.0, 4.5, 4.5, 4.5], Action.SLOWED, 1),
+    ],
+)
+def test_a_slowing_that_takes_the_way_off_is_a_stop(
+    speed_kn: list[float], action: Action, row: int
+) -> None:
+    result = conduct(np.full(len(speed_kn), 90.0), np.array(speed_kn), PARAMS)
+    assert (result.changed, result.action, result.action_row) == (Fact.TRUE, action, row)
+
+
+def test_a_low_speed_without_a_slowing_is_no_stop() -> None:
+    # 1.2 → 0.3 kn is less than speed_change_min_kn: SOG noise, and the COG cannot be judged
+    result = conduct(np.array([90.0, 90.0, 90.0]), np.array([1.2, 0.8, 0.3]), PARAMS)
+    assert result.action is Action.INSUFFICIENT
+
+
+def test_the_stop_threshold_is_a_parameter() -> None:
+    speed = np.array([10.0, 5.0, 0.9])
+    assert conduct(np.full(3, 90.0), speed, PARAMS).action is Action.SLOWED
+    at_1_kn = dataclasses.replace(PARAMS, stopped_below_kn=1.0)
+    assert conduct(np.full(3, 90.0), speed, at_1_kn).action is Action.STOPPED
+
+
+@pytest.mark.parametrize("value", [-0.1, math.nan, math.inf])
+def test_a_stop_threshold_that_is_no_speed_is_refused(value: float) -> None:
+    with pytest.raises(ParameterError, match="stopped_below_kn"):
+        dataclasses.replace(PARAMS, stopped_below_kn=value)
+
+
+# --- whether the give-way action is the kind the rule asks --------------------------------------
+
+T, F, U = Fact.TRUE, Fact.FALSE, Fact.INSUFFICIENT  # U: undecided by the data
+ACTIONS = (
+    Action.STARBOARD_TURN,
+    Action.PORT_TURN,
+    Action.SLOWED,
+    Action.STOPPED,
+    Action.SPED_UP,
+    Action.NONE,
+    Action.INSUFFICIENT,
+)
+# one row per deciding rule, in the order of ACTIONS
+EXPECTED = {
+    (Situation.HEAD_ON, DecidingRule.RULE_14): (T, F, F, F, F, F, U),
+    (Situation.CROSSING, DecidingRule.RULE_15): (T, F, T, T, F, F, U),
+    (Situation.OVERTAKING, DecidingRule.RULE_13): (T, T, T, T, F, F, U),
+    (Situation.CROSSING, DecidingRule.RULE_9): (T, T, T, T, F, F, U),
+    (Situation.HEAD_ON, DecidingRule.RULE_9): (T, T, T, T, F, F, U),
+    (Situation.CROSSING, DecidingRule.RULE_18): (T, T, T, T, F, F, U),
+    (Situation.HEAD_ON, DecidingRule.RULE_18): (T, T, T, T, F, F, U),
+}
+JUDGED = [
+    (s, r, a, e) for (s, r), row in EXPECTED.items() for a, e in zip(ACTIONS, row, strict=True)
+]
+
+
+@pytest.mark.parametrize(("situation", "rule", "action", "expected"), JUDGED)
+def test_each_rule_judges_each_kind_of_action(
+    situation: Situation, rule: DecidingRule, action: Action, expected: Fact
+) -> None:
+    assert action_as_rule_asks(situation, rule, Role.GIVE_WAY, action) is expected
+
+
+@pytest.mark.parametrize(("situation", "rule"), list(EXPECTED))
+@pytest.mark.parametrize("role", [Role.STAND_ON, Role.NONE])
+def test_only_a_give_way_vessel_is_judged(
+    situation: Situation, rule: DecidingRule, role: Role
+) -> None:
+    assert action_as_rule_asks(situation, rule, role, Action.PORT_TURN) is None
+
+
+def test_a_pair_with_no_situation_has_nothing_to_judge() -> None:
+    judged = action_as_rule_asks(Situation.NONE, DecidingRule.NONE, Role.NONE, Action.NONE)
+    assert judged is None
+
+
+@pytest.mark.parametrize(
+    ("situation", "rule"),
+    [
+        (Situation.CROSSING, DecidingRule.RULE_14),
+        (Situation.HEAD_ON, DecidingRule.RULE_15),
+        (Situation.CROSSING, DecidingRule.RULE_13),
+        (Situation.OVERTAKING, DecidingRule.RULE_18),  # rule 13 keeps every overtaking
+        (Situation.OVERTAKING, DecidingRule.RULE_9),
+        (Situation.CROSSING, DecidingRule.NONE),
+        (Situation.NONE, DecidingRule.RULE_15),
+    ],
+)
+def test_a_pair_rule9_cannot_decide_is_a_bug(situation: Situation, rule: DecidingRule) -> None:
+    with pytest.raises(ValueError, match="does not decide"):
+        action_as_rule_asks(situation, rule, Role.GIVE_WAY, Action.NONE)
+
+
+def test_the_strings_of_pairs_csv_are_accepted() -> None:
+    judged = action_as_rule_asks(
+        Situation("crossing"), DecidingRule("15"), Role("give-way"), Action("sped-up")
+    )
+    assert judged is Fact.FALSE
+    assert action_as_rule_asks("head-on", "14", "give-way", "starboard-turn") is Fact.TRUE  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("situation", "rule", "course_deg", "speed_kn", "expected"),
+    [
+        # the issue: a crossing give-way vessel that speeds up "acted", but not as rule 15 asks
+        (Situation.CROSSING, DecidingRule.RULE_15, [45.0] * 4, [8.0, 9.0, 10.5, 11.0], F),
+        (Situation.CROSSING, DecidingRule.RULE_15, [45.0] * 4, [8.0, 6.5, 3.0, 0.1], T),
+        # a port turn in a head-on situation is a change, not the alteration rule 14(a) asks
+        (Situation.HEAD_ON, DecidingRule.RULE_14, [0.0, 350.0, 340.0, 330.0], [12.0] * 4, F),
+        (Situation.HEAD_ON, DecidingRule.RULE_14, [0.0, 10.0, 20.0, 30.0], [12.0] * 4, T),
+        (Situation.OVERTAKING, DecidingRule.RULE_13, [0.0, 350.0, 340.0, 330.0], [12.0] * 4, T),
+        (Situation.OVERTAKING, DecidingRule.RULE_13, [0.0, 2.0, 1.0, 0.0], [12.0] * 4, F),
+        # a vessel too slow for her COG to show a turn, whose speed holds: cannot tell
+        (Situation.CROSSING, DecidingRule.RULE_15, [0.0, 40.0, 320.0, 10.0], [1.0] * 4, U),
+    ],
+)
+def test_from_a_track_to_the_judgement(
+    situation: Situation,
+    rule: DecidingRule,
+    course_deg: list[float],
+    speed_kn: list[float],
+    expected: Fact,
+) -> None:
+    action = conduct(np.array(course_deg), np.array(speed_kn), PARAMS).action
+    assert action_as_rule_asks(situation, rule, Role.GIVE_WAY, action) is expected
+
+
+# --- rule 17(c) -----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("action", "bearing_deg", "expected"),
+    [
+        (Action.PORT_TURN, 300.0, T),  # the give-way vessel on her port bow: 17(c) breached
+        (Action.PORT_TURN, 190.0, T),
+        (Action.PORT_TURN, -60.0, T),  # any bearing is wrapped
+        (Action.PORT_TURN, 660.0, T),
+        (Action.PORT_TURN, 60.0, F),  # on her starboard side: 17(c) does not forbid it
+        (Action.PORT_TURN, 0.0, F),  # dead ahead and dead astern are on neither side
+        (Action.PORT_TURN, 180.0, F),
+        (Action.STARBOARD_TURN, 300.0, F),
+        (Action.SLOWED, 300.0, F),
+        (Action.STOPPED, 300.0, F),
+        (Action.SPED_UP, 300.0, F),
+        (Action.NONE, 300.0, F),  # she kept her course and speed (rule 17(a)(i))
+        (Action.INSUFFICIENT, 300.0, U),
+        (Action.PORT_TURN, math.nan, U),
+        (Action.STARBOARD_TURN, math.nan, F),
+    ],
+)
+def test_rule_17c_in_a_crossing(action: Action, bearing_deg: float, expected: Fact) -> None:
+    judged = stand_on_turned_to_port_for_vessel_on_port(
+        Situation.CROSSING, DecidingRule.RULE_15, Role.STAND_ON, action, bearing_deg
+    )
+    assert judged is expected
+
+
+@pytest.mark.parametrize(
+    ("situation", "rule", "role"),
+    [
+        (Situation.CROSSING, DecidingRule.RULE_15, Role.GIVE_WAY),
+        (Situation.CROSSING, DecidingRule.RULE_18, Role.STAND_ON),
+        (Situation.CROSSING, DecidingRule.RULE_9, Role.STAND_ON),
+        (Situation.HEAD_ON, DecidingRule.RULE_18, Role.STAND_ON),
+        (Situation.OVERTAKING, DecidingRule.RULE_13, Role.STAND_ON),
+        (Situation.NONE, DecidingRule.NONE, Role.NONE),
+    ],
+)
+def test_rule_17c_binds_only_the_stand_on_vessel_of_a_rule_15_crossing(
+    situation: Situation, rule: DecidingRule, role: Role
+) -> None:
+    judged = stand_on_turned_to_port_for_vessel_on_port(
+        situation, rule, role, Action.PORT_TURN, 300.0
+    )
+    assert judged is None
+
+
+# --- properties -----------------------------------------------------------------------------
+
+MIRRORED = {Action.STARBOARD_TURN: Action.PORT_TURN, Action.PORT_TURN: Action.STARBOARD_TURN}
+
+
+def _mirrored(action: Action) -> Action:
+    return MIRRORED.get(action, action)
+
+
+# whole degrees within ±170° of the first course: the mirrored sums are exact, and no change
+# is the ±180° that wraps to the same side
+_tracks = st.integers(2, 12).flatmap(
+    lambda n: st.tuples(
+        st.integers(0, 359),
+        st.lists(st.integers(-170, 170), min_size=n, max_size=n),
+        st.lists(
+            st.sampled_from([0.2, 0.5, 1.0, 2.0, 4.0, 6.0, 8.0, 12.0]), min_size=n, max_size=n
+        ),
+    )
+)
+
+
+@given(_tracks)
+def test_a_mirrored_track_gives_the_mirrored_action(
+    track: tuple[int, list[int], list[float]],
+) -> None:
+    first_deg, offsets_deg, speed_kn = track
+    course = np.array([(first_deg + off) % 360 for off in offsets_deg], dtype=float)
+    mirror = np.array([(-c) % 360 for c in course], dtype=float)
+    seen = conduct(course, np.array(speed_kn), PARAMS)
+    seen_mirrored = conduct(mirror, np.array(speed_kn), PARAMS)
+    assert seen_mirrored.action is _mirrored(seen.action)
+    assert (seen_mirrored.changed, seen_mirrored.action_row) == (seen.changed, seen.action_row)
+
+
+@given(_tracks)
+def test_a_stop_is_a_slowing_that_goes_below_the_threshold(
+    track: tuple[int, list[int], list[float]],
+) -> None:
+    first_deg, offsets_deg, speed_kn = track
+    course = np.array([(first_deg + off) % 360 for off in offsets_deg], dtype=float)
+    never = conduct(course, np.array(speed_kn), dataclasses.replace(PARAMS, stopped_below_kn=0.0))
+    seen = conduct(course, np.array(speed_kn), PARAMS)
+    assert never.action is not Action.STOPPED
+    expected = Action.SLOWED if seen.action is Action.STOPPED else seen.action
+    assert (never.action, never.action_row) == (expected, seen.action_row)
+    if seen.action is Action.STOPPED:
+        assert min(speed_kn) < PARAMS.stopped_below_kn
+
+
+@given(st.sampled_from(list(EXPECTED)), st.sampled_from(ACTIONS))
+def test_a_mirrored_action_is_judged_by_the_side_the_rule_names(
+    decided: tuple[Situation, DecidingRule], action: Action
+) -> None:
+    situation, rule = decided
+    judged = action_as_rule_asks(situation, rule, Role.GIVE_WAY, action)
+    mirrored = action_as_rule_asks(situation, rule, Role.GIVE_WAY, _mirrored(action))
+    names_a_side = rule in (DecidingRule.RULE_14, DecidingRule.RULE_15)
+    if names_a_side and action in MIRRORED:
+        assert mirrored is negated(judged or Fact.INSUFFICIENT)
+    else:
+        assert mirrored is judged
+
+
+# away from dead ahead and astern, where a bearing of -1e-82° wraps to 0° (neither side)
+@given(st.floats(-720.0, 720.0).filter(lambda b: 1e-6 < b % 180.0 < 180.0 - 1e-6))
+def test_rule_17c_a_port_turn_breaches_it_on_exactly_one_of_mirrored_bearings(
+    bearing_deg: float,
+) -> None:
+    def breached(bearing: float) -> Fact | None:
+        return stand_on_turned_to_port_for_vessel_on_port(
+            Situation.CROSSING, DecidingRule.RULE_15, Role.STAND_ON, Action.PORT_TURN, bearing
+        )
+
+    assert {breached(bearing_deg), breached(-bearing_deg)} == {Fact.TRUE, Fact.FALSE}
+    assert breached(bearing_deg + 360.0) is breached(bearing_deg)

@@ -18,6 +18,7 @@ from colregs9_cli.charts.sources import read_charts
 from colregs9_cli.charts.water import HAZARD_RADIUS_M, Chart, load_chart
 from colregs9_cli.core.manoeuvrability import (
     ManoeuvrabilityParams,
+    SwingModel,
     VesselState,
     assess_manoeuvrability,
 )
@@ -240,7 +241,7 @@ def test_draw_assessment_colours_ellipses_by_flag(enc: Chart) -> None:
         enc,
         VesselState(3014.5, -1696.3, 145.0, 3.6),
         VesselDimensions(50.0, 9.0, 5.0, defaulted=(), basis=""),
-        ManoeuvrabilityParams(),
+        ManoeuvrabilityParams(swing_model=SwingModel.FIXED),
     )
     figure = Figure()
     ax = figure.subplots()

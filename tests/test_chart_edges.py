@@ -16,6 +16,7 @@ from colregs9_cli.charts.water import Chart, load_chart
 from colregs9_cli.core.manoeuvrability import (
     ManoeuvrabilityParams,
     Restriction,
+    SwingModel,
     VesselState,
     assess_manoeuvrability,
 )
@@ -24,7 +25,7 @@ from colregs9_cli.errors import ChartError
 from colregs9_cli.geo import LocalFrame
 
 FRAME = LocalFrame(57.0, 10.0)
-PARAMS = ManoeuvrabilityParams()
+PARAMS = ManoeuvrabilityParams(swing_model=SwingModel.FIXED)
 # The target: 50 m long, 9 m in the beam, 5 m draught, all as reported by AIS.
 DIMS = VesselDimensions(50.0, 9.0, 5.0, defaulted=(), basis="")
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import pytest
 
+from colregs9_cli.core.rows import situation_or_interaction
 from colregs9_cli.jobs.replay import run_replay
 from colregs9_cli.jobs.stats import run_stats
 from colregs9_cli.report.html_report import ENCOUNTER_TABLE_COLUMNS, pair_numbers
@@ -90,7 +91,7 @@ def test_replay_page_shows_every_encounter_and_figure(national_report, tmp_path)
 
 def test_replay_page_filters_and_sorts_in_the_browser(national_report, tmp_path) -> None:
     result, out = national_report
-    head_on = sum(o.summary.situation.value == "head-on" for o in result.encounters)
+    head_on = sum(situation_or_interaction(o.summary) == "head-on" for o in result.encounters)
     assert 0 < head_on < len(result.encounters)
     sort = ENCOUNTER_TABLE_COLUMNS.index("CPA (m)")
     dom = rendered(out / "index.html", tmp_path, f"?q=head-on&sort={sort}")

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 import tomllib
+from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -15,22 +17,34 @@ from hypothesis import strategies as st
 from colregs9_cli.charts.s57_classes import ChartLayer
 from colregs9_cli.charts.water import Chart, load_chart
 from colregs9_cli.core.manoeuvrability import (
+    TURN_RADIUS_LENGTHS,
+    ManoeuvrabilityAssessment,
     ManoeuvrabilityParams,
     Restriction,
     RestrictionPolicy,
     SwingModel,
     VesselState,
+    arc_turn_radius_m,
     assess_manoeuvrability,
     ellipse_polygons,
+    imo_turn_radius_m,
     reference_vessels,
     restricted_flags,
+    scaled_rate_of_swing_deg_per_m,
     target_rate_of_swing_deg_per_m,
     turning_arcs,
+    unplaced_assessment,
     verdict,
 )
 from colregs9_cli.core.vessel_defaults import VesselDimensions
 from colregs9_cli.errors import ParameterError, QueryError
 from colregs9_cli.geo import LocalFrame
+
+
+def paper(**changes: object) -> ManoeuvrabilityParams:
+    """The paper's estimator settings (its fixed 0.2 deg/m), with ``changes``."""
+    return ManoeuvrabilityParams(swing_model=SwingModel.FIXED, **changes)  # type: ignore[arg-type]
+
 
 ENC = Path(__file__).resolve().parents[1] / "fixtures" / "charts" / "noaa_enc_US5MD1MC.000"
 SEVEN_KN_MPS = 7.0 * 1852.0 / 3600.0
@@ -128,10 +142,16 @@ def test_arc_points_lie_on_the_turning_circle_within_the_path_length(
 
 def test_alpha_scales_the_turn_radius_by_its_inverse() -> None:
     full = assess_manoeuvrability(
-        None, VesselState(0.0, 0.0, 0.0, 3.0), DIMS, ManoeuvrabilityParams(alpha=1.0)
+        None,
+        VesselState(0.0, 0.0, 0.0, 3.0),
+        DIMS,
+        paper(alpha=1.0),
     )
     scaled = assess_manoeuvrability(
-        None, VesselState(0.0, 0.0, 0.0, 3.0), DIMS, ManoeuvrabilityParams(alpha=0.4)
+        None,
+        VesselState(0.0, 0.0, 0.0, 3.0),
+        DIMS,
+        paper(alpha=0.4),
     )
     assert scaled.turn_radius_m / full.turn_radius_m == pytest.approx(2.5)
     # The paper's δ' = 0.4 · 0.2 deg/m = 0.08 deg/m, r = 1 / δ'_rad ≈ 716.2 m.
@@ -171,7 +191,7 @@ def _square_chart(shoal_south_m: float) -> Chart:
     )
 
 
-def _at_rest(chart: Chart, **params: object) -> object:
+def _at_rest(chart: Chart, **params: Any) -> ManoeuvrabilityAssessment:
     # At rest, heading north: every projected ellipse is the one at the origin, a = 50 m.
     return assess_manoeuvrability(
         chart, VesselState(0.0, 0.0, 0.0, 0.0), DIMS, ManoeuvrabilityParams(**params)
@@ -196,7 +216,10 @@ def test_a_vessel_at_rest_is_assessed_where_she_lies() -> None:
 
 def test_no_chart_gives_unknown() -> None:
     assessment = assess_manoeuvrability(
-        None, VesselState(0.0, 0.0, 0.0, 3.0), DIMS, ManoeuvrabilityParams()
+        None,
+        VesselState(0.0, 0.0, 0.0, 3.0),
+        DIMS,
+        paper(),
     )
     assert assessment.restriction is Restriction.UNKNOWN
     assert not assessment.covered.any()
@@ -228,7 +251,7 @@ def test_restriction_flags_are_translation_invariant(
             chart.coverage, lambda xy: xy + np.array([shift_east, shift_north])
         ),
     )
-    params = ManoeuvrabilityParams(horizon_s=60.0)
+    params = paper(horizon_s=60.0)
     here = assess_manoeuvrability(chart, VesselState(north, east, course, 3.0), DIMS, params)
     there = assess_manoeuvrability(
         moved, VesselState(north + shift_north, east + shift_east, course, 3.0), DIMS, params
@@ -300,7 +323,10 @@ def test_arcs_leaving_the_extent_mark_their_positions_uncovered(
     position is covered only when its whole ellipse is inside the square."""
     chart = _square_chart(-500.0)  # the shoal is south of every arc
     assessment = assess_manoeuvrability(
-        chart, VesselState(start_north_m, 0.0, 0.0, SEVEN_KN_MPS), DIMS, ManoeuvrabilityParams()
+        chart,
+        VesselState(start_north_m, 0.0, 0.0, SEVEN_KN_MPS),
+        DIMS,
+        paper(),
     )
     ellipse_north_edge = shapely.bounds(assessment.ellipses)[:, 3]
     reaches_out = ellipse_north_edge > 1000.0
@@ -345,9 +371,170 @@ def test_model_choice(model: str, length_m: float | None, radius_m: float) -> No
 
 
 def test_fixed_model_uses_the_given_value() -> None:
-    assert target_rate_of_swing_deg_per_m(50.0, ManoeuvrabilityParams()) == 0.2
-    params = ManoeuvrabilityParams(swing_deg_per_m=0.35)
+    assert target_rate_of_swing_deg_per_m(50.0, paper()) == 0.2
+    params = paper(swing_deg_per_m=0.35)
     assert target_rate_of_swing_deg_per_m(300.0, params) == 0.35
+
+
+# The length-scaled model: r_turn = 2.5 L (MSC.137(76) 5.3.1: tactical diameter <= 5 L), and
+# the arcs use r = r_turn / α.
+LENGTH_SCALED = ManoeuvrabilityParams(swing_model=SwingModel.LENGTH_SCALED)
+
+
+@pytest.mark.parametrize(
+    ("length_m", "alpha", "hard_over_radius_m", "arc_radius_m"),
+    [
+        (12.0, 0.4, 30.0, 75.0),  # a 12 m yacht: 2.5·12 = 30 m, / 0.4 = 75 m
+        (50.1, 0.4, 125.25, 313.125),  # the paper's Table 1 mean length (vessel defaults)
+        (100.0, 0.4, 250.0, 625.0),
+        (300.0, 1.0, 750.0, 750.0),  # α = 1: the hard-over circle itself
+        (12.0, 0.1, 30.0, 300.0),
+    ],
+)
+def test_length_scaled_radius_and_rate_by_hand(
+    length_m: float, alpha: float, hard_over_radius_m: float, arc_radius_m: float
+) -> None:
+    params = ManoeuvrabilityParams(swing_model=SwingModel.LENGTH_SCALED, alpha=alpha)
+    assert float(imo_turn_radius_m(length_m)) == pytest.approx(hard_over_radius_m)
+    # δ_swing = 360 / (2π r_turn): the 12 m yacht swings 360/(2π·30) = 1.9099 deg/m.
+    rate = target_rate_of_swing_deg_per_m(length_m, params)
+    assert rate == pytest.approx(360.0 / (2.0 * math.pi * hard_over_radius_m))
+    assert scaled_rate_of_swing_deg_per_m(length_m, params) == pytest.approx(alpha * rate)
+    assert arc_turn_radius_m(length_m, params) == pytest.approx(arc_radius_m)
+
+
+def test_a_12_m_yacht_swings_1_91_deg_per_m_and_0_76_after_alpha() -> None:
+    assert target_rate_of_swing_deg_per_m(12.0, LENGTH_SCALED) == pytest.approx(1.90986, abs=1e-5)
+    assert scaled_rate_of_swing_deg_per_m(12.0, LENGTH_SCALED) == pytest.approx(0.76394, abs=1e-5)
+
+
+@given(
+    short_m=st.floats(1.0, 450.0),
+    longer_by_m=st.floats(0.01, 100.0),
+    alpha=st.floats(0.05, 1.0),
+)
+def test_length_scaled_radius_grows_with_length_in_proportion(
+    short_m: float, longer_by_m: float, alpha: float
+) -> None:
+    params = ManoeuvrabilityParams(swing_model=SwingModel.LENGTH_SCALED, alpha=alpha)
+    short_r = arc_turn_radius_m(short_m, params)
+    long_r = arc_turn_radius_m(short_m + longer_by_m, params)
+    assert long_r > short_r
+    assert short_r / short_m == pytest.approx(TURN_RADIUS_LENGTHS / alpha)
+
+
+@given(length_m=st.floats(1.0, 450.0), alpha=st.floats(0.05, 1.0))
+def test_alpha_applies_on_top_of_the_length_scaled_model(length_m: float, alpha: float) -> None:
+    """α is the fraction of the hard-over turning ability used, for every model alike."""
+    params = ManoeuvrabilityParams(swing_model=SwingModel.LENGTH_SCALED, alpha=alpha)
+    full = ManoeuvrabilityParams(swing_model=SwingModel.LENGTH_SCALED, alpha=1.0)
+    assert arc_turn_radius_m(length_m, params) == pytest.approx(
+        arc_turn_radius_m(length_m, full) / alpha
+    )
+
+
+def test_alpha_zero_gives_straight_arcs_for_the_length_scaled_model() -> None:
+    params = ManoeuvrabilityParams(swing_model=SwingModel.LENGTH_SCALED, alpha=0.0)
+    assert arc_turn_radius_m(12.0, params) == math.inf
+    yacht = VesselDimensions(12.0, 4.0, 1.2, defaulted=(), basis="")
+    assessment = assess_manoeuvrability(None, VesselState(0.0, 0.0, 0.0, 2.0), yacht, params)
+    assert assessment.turn_radius_m == math.inf
+    np.testing.assert_allclose(assessment.east_m, 0.0, atol=1e-9)
+
+
+@given(length_m=st.floats(0.5, 450.0) | st.none(), alpha=st.floats(0.0, 1.0))
+def test_the_fixed_model_is_unchanged(length_m: float | None, alpha: float) -> None:
+    """The paper's model: 0.2 deg/m whatever the length, so r = 1 / (α·0.2°) per metre."""
+    params = paper(alpha=alpha)
+    assert target_rate_of_swing_deg_per_m(length_m, params) == 0.2
+    assert scaled_rate_of_swing_deg_per_m(length_m, params) == alpha * 0.2
+    expected_m = 180.0 / (math.pi * alpha * 0.2) if alpha > 0.0 else math.inf
+    assert arc_turn_radius_m(length_m, params) == pytest.approx(expected_m)
+
+
+def test_real_ais_turns_on_arcs_sized_for_the_vessel_by_default() -> None:
+    default = ManoeuvrabilityParams()
+    assert default.swing_model is SwingModel.LENGTH_SCALED
+    # a 12 m yacht and a 300 m ship no longer share the paper's 716 m circle
+    assert arc_turn_radius_m(12.0, default) == pytest.approx(75.0)
+    assert arc_turn_radius_m(300.0, default) == pytest.approx(1875.0)
+
+
+def test_the_papers_fixed_radius_is_716_m_for_every_vessel() -> None:
+    radii = {arc_turn_radius_m(length_m, paper()) for length_m in (3.0, 300.0)}
+    assert len(radii) == 1
+    assert radii.pop() == pytest.approx(716.197, abs=1e-3)
+
+
+def test_the_greenhopper_demo_keeps_the_fixed_model() -> None:
+    demo = resources.files("colregs9_cli").joinpath("data/demo/greenhopper.toml")
+    table = tomllib.loads(demo.read_text(encoding="utf-8"))["manoeuvrability"]
+    params = ManoeuvrabilityParams.from_table(table, "greenhopper.toml")
+    assert params.swing_model is SwingModel.FIXED
+    assert arc_turn_radius_m(50.0, params) == pytest.approx(716.197, abs=1e-3)
+
+
+def test_a_12_m_yachts_arcs_stay_within_her_150_m_turning_circle() -> None:
+    """At 5 kn for 180 s she sails 463 m: nearly a whole circle of radius 75 m, so no projected
+    position lies farther than its diameter, 150 m, from her (the paper's fixed 716 m
+    radius sends her 450 m away)."""
+    yacht = VesselDimensions(12.0, 4.0, 1.2, defaulted=(), basis="")
+    state = VesselState(0.0, 0.0, 30.0, 5.0 * 1852.0 / 3600.0)
+    scaled = assess_manoeuvrability(None, state, yacht, LENGTH_SCALED)
+    assert scaled.turn_radius_m == pytest.approx(75.0)
+    reach_m = np.hypot(scaled.north_m, scaled.east_m)
+    assert reach_m.max() <= 2.0 * 75.0 + 1e-6
+    assert reach_m.max() > 140.0  # she does get round to the far side of the circle
+    fixed = assess_manoeuvrability(None, state, yacht, paper())
+    assert np.hypot(fixed.north_m, fixed.east_m).max() > 440.0
+
+
+@given(length_m=st.floats(1.0, 450.0))
+def test_the_assessments_radius_is_the_public_one(length_m: float) -> None:
+    dims = VesselDimensions(length_m, 5.0, 2.0, defaulted=(), basis="")
+    placed = assess_manoeuvrability(None, VesselState(0.0, 0.0, 0.0, 3.0), dims, LENGTH_SCALED)
+    unplaced = unplaced_assessment(dims, LENGTH_SCALED)
+    for assessment in (placed, unplaced):
+        assert assessment.turn_radius_m == pytest.approx(arc_turn_radius_m(length_m, LENGTH_SCALED))
+        assert assessment.rate_of_swing_deg_per_m == scaled_rate_of_swing_deg_per_m(
+            length_m, LENGTH_SCALED
+        )
+
+
+@pytest.mark.parametrize("length_m", [None, math.nan, math.inf])
+def test_an_unknown_length_takes_the_tables_lower_bound(length_m: float | None) -> None:
+    """As for nearest-length: the slowest turner of the table, r = 740.8 m. A replay never
+    gets here: core.vessel_defaults fills in a length (and flags it as defaulted)."""
+    rate = target_rate_of_swing_deg_per_m(length_m, LENGTH_SCALED)
+    assert rate == pytest.approx(360.0 / (2.0 * math.pi * 740.8))
+    assert arc_turn_radius_m(length_m, LENGTH_SCALED) == pytest.approx(740.8 / 0.4)  # 1852 m
+
+
+@pytest.mark.parametrize("length_m", [0.0, -12.0])
+def test_a_length_that_is_not_positive_is_an_error(length_m: float) -> None:
+    with pytest.raises(ParameterError, match="length_m"):
+        target_rate_of_swing_deg_per_m(length_m, LENGTH_SCALED)
+
+
+def test_length_scaled_radii_against_the_papers_reference_vessels() -> None:
+    """2.5 L is within a factor 2 of every reference vessel's radius (the worst: the
+    265.6 m Becker-rudder vessel, 1.94); the fixed 286.5 m is off by 3.9 for the 33 m
+    fishing vessel. 2.5 L is the wider circle for 11 of the 14: it is the standard's bound,
+    and three of the table's (shallow-water) circles exceed it."""
+    table = reference_vessels()
+    ratio = imo_turn_radius_m(table["length_m"]) / table["turn_radius_m"].to_numpy()
+    assert ratio.max() == pytest.approx(1.94, abs=0.005)
+    assert ratio.min() == pytest.approx(0.69, abs=0.005)
+    assert (ratio >= 1.0).sum() == 11
+    fixed_m = 360.0 / (2.0 * math.pi * 0.2)
+    fixed_ratio = fixed_m / table["turn_radius_m"].to_numpy()
+    assert max(fixed_ratio.max(), 1.0 / fixed_ratio.min()) == pytest.approx(3.87, abs=0.005)
+
+
+def test_length_scaled_from_a_toml_table() -> None:
+    table = tomllib.loads("[manoeuvrability]\nswing_model = 'length-scaled'\nalpha = 0.4\n")
+    params = ManoeuvrabilityParams.from_table(table["manoeuvrability"], "q.toml")
+    assert params.swing_model is SwingModel.LENGTH_SCALED
 
 
 def test_params_from_a_toml_table() -> None:
@@ -367,17 +554,17 @@ def test_params_reject_unknown_keys_and_bad_values() -> None:
     with pytest.raises(QueryError, match="policy"):
         ManoeuvrabilityParams.from_table({"policy": "port"}, "q.toml [manoeuvrability]")
     with pytest.raises(ParameterError, match=r"alpha 1.5 is outside \[0, 1\]"):
-        ManoeuvrabilityParams(alpha=1.5)
+        paper(alpha=1.5)
     with pytest.raises(ParameterError, match="ukc_m -1"):
-        ManoeuvrabilityParams(ukc_m=-1.0)
+        paper(ukc_m=-1.0)
     with pytest.raises(ParameterError, match="horizon_s"):
-        ManoeuvrabilityParams(horizon_s=0.0)
+        paper(horizon_s=0.0)
     with pytest.raises(ParameterError, match="longer than horizon_s"):
-        ManoeuvrabilityParams(horizon_s=10.0, step_s=20.0)
+        paper(horizon_s=10.0, step_s=20.0)
 
 
 def test_bad_target_values_are_errors() -> None:
-    params = ManoeuvrabilityParams()
+    params = paper()
     with pytest.raises(ParameterError, match="draught_m -1"):
         assess_manoeuvrability(
             None,
@@ -436,7 +623,10 @@ def test_a_vessel_heading_along_the_severn_channel_is_restricted(enc: Chart) -> 
     assert 130.0 < axis_deg < 160.0
     for course in (axis_deg, axis_deg + 180.0):
         assessment = assess_manoeuvrability(
-            enc, VesselState(north, east, course % 360, SEVEN_KN_MPS), DIMS, ManoeuvrabilityParams()
+            enc,
+            VesselState(north, east, course % 360, SEVEN_KN_MPS),
+            DIMS,
+            paper(),
         )
         assert assessment.restriction is Restriction.RESTRICTED
         # She starts clear in the channel; the turns run her out of it.
@@ -448,7 +638,10 @@ def test_a_vessel_heading_along_the_severn_channel_is_restricted(enc: Chart) -> 
 def test_the_same_vessel_in_the_widest_deep_water_is_not(enc: Chart, course: float) -> None:
     north, east = _widest_deep_water(enc)
     assessment = assess_manoeuvrability(
-        enc, VesselState(north, east, course, SEVEN_KN_MPS), DIMS, ManoeuvrabilityParams()
+        enc,
+        VesselState(north, east, course, SEVEN_KN_MPS),
+        DIMS,
+        paper(),
     )
     assert assessment.restriction is Restriction.NOT_RESTRICTED
     assert not assessment.restricted.any()
@@ -456,7 +649,10 @@ def test_the_same_vessel_in_the_widest_deep_water_is_not(enc: Chart, course: flo
 
 def test_outside_the_chart_is_unknown(enc: Chart) -> None:
     assessment = assess_manoeuvrability(
-        enc, VesselState(20_000.0, 20_000.0, 0.0, SEVEN_KN_MPS), DIMS, ManoeuvrabilityParams()
+        enc,
+        VesselState(20_000.0, 20_000.0, 0.0, SEVEN_KN_MPS),
+        DIMS,
+        paper(),
     )
     assert assessment.restriction is Restriction.UNKNOWN
     assert not assessment.covered.any()

@@ -61,11 +61,13 @@ def test_replay_prints_a_summary_and_writes_the_reports(tmp_path: Path) -> None:
     result = _invoke(str(NMEA), "--no-plots", "--quiet", "--out", str(tmp_path))
     assert result.exit_code == 0, result.output
     table = pd.read_csv(tmp_path / "encounters.csv")
-    # One summary line per triggered pair, each naming its id, between counts and footer.
+    # The counts, the pairs by interaction, a header and one line per triggered pair.
     pairs = pd.read_csv(tmp_path / "pairs.csv")
     for pair_id in pairs["pair_id"]:
         assert pair_id in result.output
-    assert len(result.output.splitlines()) == len(pairs) + 2
+    assert len(result.output.splitlines()) == len(pairs) + 3
+    by_kind = pairs["interaction"].value_counts()
+    assert f"{len(pairs)} pairs: {by_kind['encounter']} encounters" in result.output
     assert "24 triggered" in result.output
     assert "Reports in" not in result.output  # --quiet drops the notice
     assert not list((tmp_path / "encounters").glob("*.png"))

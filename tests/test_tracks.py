@@ -9,18 +9,28 @@ import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from pyproj import Geod
+from test_replay_cli import write_dma
 
 from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
+from colregs9_cli.core.ais_claims import Fixes, SogCheckParams, contradicted_sog
+from colregs9_cli.core.encounters import EncounterParams, find_encounters
 from colregs9_cli.core.tracks import (
+    NO_TRACK_STATS,
     SAMPLE_COLUMNS,
     CourseSource,
     TrackParams,
     TrackStats,
     build_tracks,
+    empty_carry,
+    report_table,
+    segment_reports,
 )
 from colregs9_cli.geo import LocalFrame
+from colregs9_cli.jobs.replay import run_replay
 from colregs9_cli.units import MPS_PER_KNOT
 
 FRAME = LocalFrame(57.05, 9.94)
@@ -325,6 +335,7 @@ def test_real_nmea_sample(fixtures_dir: Path) -> None:
         gap_splits=0,
         segments=1438 + 3,
         samples=117411,
+        sog_contradicted=0,
     )
     assert len(tracks.vessels) == 1112
     assert tracks.samples["mmsi"].nunique() == 1112
@@ -388,3 +399,242 @@ def test_a_track_across_the_antimeridian_is_resampled_on_the_earth() -> None:
     assert abs(middle["lon_deg"]) == pytest.approx(180.0, abs=1e-9)
     assert middle["lat_deg"] == pytest.approx(0.0, abs=1e-12)
     assert np.isnan(middle["north_m"]) and np.isnan(middle["east_m"])
+
+
+# -- rule 3a: a reported SOG that the vessel's own positions contradict ------------------------
+
+YACHT = 219000009
+NO_SOG_CHECK = TrackParams(sog_check=SogCheckParams(max_gap_s=0.0))  # no neighbour counts
+
+
+def _yacht(t_s: tuple[float, ...] = (0.0, 30.0, 60.0, 90.0)) -> pd.DataFrame:
+    """A yacht at one fixed position reporting 102.2 kn (AIS's largest SOG) on 045°, every
+    30 s (a Class B "CS" above 2 kn)."""
+    n = len(t_s)
+    return reports(list(t_s), [0.0] * n, [0.0] * n, mmsi=YACHT, sog_kn=102.2, cog_deg=45.0)
+
+
+def test_a_yacht_reporting_102_kn_from_one_fixed_position_is_at_rest() -> None:
+    tracks = build_tracks(_yacht(), FRAME, TrackParams())
+    # All four: the middle two over 60 s, the ends one-sided over 30 s (she would have made
+    # good 0.5 * 52.6 m/s * (30 - 10) s - 20 m = 506 m at least; she made 0 m).
+    assert tracks.stats.sog_contradicted == 4
+    assert tracks.stats.reports_used == 4
+    assert tracks.samples["sog_kn"].to_numpy() == pytest.approx(0.0, abs=1e-9)
+    assert tracks.stats.samples == 0  # not under way
+    believed = build_tracks(_yacht(), FRAME, NO_SOG_CHECK)
+    assert believed.stats.sog_contradicted == 0
+    assert believed.samples["sog_kn"].to_numpy() == pytest.approx(102.2)
+
+
+def test_the_yacht_at_rest_forms_no_candidate_pair() -> None:
+    # A vessel eastbound at 10 kn passes 300 m south of her: with her SOG believed, the two
+    # are a candidate pair; at rest, the yacht is in none.
+    passer = reports(
+        list(range(-60, 151, 10)),
+        [-300.0] * 22,
+        [5.144 * s for s in range(-60, 151, 10)],
+        mmsi=219000010,
+        sog_kn=10.0,
+        cog_deg=90.0,
+    )
+    both = pd.concat([_yacht(), passer], ignore_index=True)
+    believed = find_encounters(build_tracks(both, FRAME, NO_SOG_CHECK), EncounterParams())
+    assert believed.candidate_pair_steps > 0
+    checked = find_encounters(build_tracks(both, FRAME, TrackParams()), EncounterParams())
+    assert checked.candidate_pair_steps == 0
+    assert checked.encounters == ()
+
+
+def test_a_sog_the_positions_agree_with_is_untouched() -> None:
+    # 5 m/s north reported as 9.72 kn every 10 s, and a slow vessel whose SOG (0.1 kn) is
+    # far below what her scattered fixes imply (100 m in 20 s): a SOG lower than the
+    # positions is never contradicted.
+    agreeing = northbound(list(range(0, 201, 10)))
+    scattered = reports(
+        [0, 10, 20, 30, 40],
+        [0.0, 60.0, -40.0, 50.0, 0.0],
+        [0.0, -30.0, 20.0, 40.0, 0.0],
+        mmsi=219000011,
+        sog_kn=0.1,
+        cog_deg=[216.0, 227.6, 269.7, 267.4, 275.4],
+    )
+    both = pd.concat([agreeing, scattered], ignore_index=True)
+    tracks = build_tracks(both, FRAME, TrackParams())
+    assert tracks.stats.sog_contradicted == 0
+    samples = tracks.samples
+    assert samples.loc[samples["mmsi"] == 219000001, "sog_kn"].to_numpy() == pytest.approx(
+        5.0 / MPS_PER_KNOT
+    )
+    assert samples.loc[samples["mmsi"] == 219000011, "sog_kn"].to_numpy() == pytest.approx(0.1)
+
+
+def test_a_fast_craft_repeating_a_stale_fix_keeps_her_sog() -> None:
+    # 219601000 in the DMA NMEA sample: 36.6 kn, a report every 2 s, one fix repeated at
+    # three reports. Spans of 4 s are shorter than stale_s: never judged.
+    speed_mps = 36.6 * MPS_PER_KNOT
+    t = [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]
+    north = [speed_mps * s for s in (0.0, 2.0, 4.0, 4.0, 4.0, 10.0)]
+    tracks = build_tracks(reports(t, north, [0.0] * 6, sog_kn=36.6), FRAME, TrackParams())
+    assert tracks.stats.sog_contradicted == 0
+    assert tracks.samples["sog_kn"].to_numpy() == pytest.approx(36.6)
+
+
+def _fixes(t_s: list[float], north_m: list[float], cog_deg: list[float]) -> Fixes:
+    lat, lon = FRAME.to_geodetic(north_m, [0.0] * len(north_m))
+    return Fixes(
+        np.asarray(t_s, dtype=float),
+        np.asarray(lat, dtype=float),
+        np.asarray(lon, dtype=float),
+        np.asarray(cog_deg, dtype=float),
+    )
+
+
+def _judge(
+    sog_kn: float,
+    chord_m: float,
+    cogs: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    span_s: tuple[float, float] = (30.0, 30.0),
+) -> bool:
+    """Whether a report between neighbours span_s before and after, chord_m apart
+    (half-way: the report itself lies in the middle), contradicts sog_kn."""
+    result = contradicted_sog(
+        np.array([sog_kn]),
+        _fixes([0.0], [chord_m / 2.0], [cogs[1]]),
+        _fixes([-span_s[0]], [0.0], [cogs[0]]),
+        _fixes([span_s[1]], [chord_m], [cogs[2]]),
+        SogCheckParams(),
+    )
+    return bool(result[0])
+
+
+def test_the_sog_check_thresholds_worked_by_hand() -> None:
+    # 20 kn over 60 s claims at least 0.5 * 10.2889 m/s * (60 - 10) s - 2 * 10 m = 237.2 m.
+    assert _judge(20.0, 230.0)
+    assert not _judge(20.0, 245.0)
+    # An excess of 3 kn or less is not judged: 2.9 kn with no movement at all stands.
+    assert _judge(4.0, 0.0)
+    assert not _judge(2.9, 0.0)
+    # Reported COGs that turn by more than 90° (a loop): the chord says nothing.
+    assert not _judge(20.0, 0.0, cogs=(177.0, 6.0, 180.0))
+    assert _judge(20.0, 0.0, cogs=(10.0, 60.0, 95.0))
+    # Neighbours more than 180 s away are not used; a span of 10 s or less is never judged.
+    assert not _judge(20.0, 0.0, span_s=(181.0, 181.0))
+    assert _judge(20.0, 0.0, span_s=(181.0, 180.0))  # one-sided, 180 s
+    assert not _judge(102.2, 0.0, span_s=(5.0, 5.0))
+    # A null SOG is not contradicted; a report with no neighbour is not judged.
+    assert not _judge(np.nan, 0.0)
+    alone = contradicted_sog(
+        np.array([50.0]),
+        _fixes([0.0], [0.0], [0.0]),
+        _fixes([np.nan], [np.nan], [np.nan]),
+        _fixes([np.nan], [np.nan], [np.nan]),
+        SogCheckParams(),
+    )
+    assert not alone[0]
+
+
+def _streamed(reports_table: pd.DataFrame, slab_s: float, params: TrackParams):
+    """Rules 1-3a slab by slab (as ``slabs.segment_part`` runs them): the kept reports, in
+    MMSI and time order, the counts, and how many came out in a later slab than their own."""
+    slab = np.floor(reports_table["t_s"].to_numpy() / slab_s).astype(np.int64)
+    indices = np.unique(slab)
+    carry, stats, kept, late = empty_carry(), NO_TRACK_STATS, [], 0
+    for n, index in enumerate(indices):
+        until = None if n == len(indices) - 1 else (index + 1) * slab_s
+        part = segment_reports(reports_table[slab == index], carry, params, until)
+        carry, stats = part.carry, stats + part.stats
+        kept.append(part.kept)
+        late += int((part.kept["t_s"] < index * slab_s).sum())
+    streamed = pd.concat(kept, ignore_index=True)
+    order = np.lexsort((streamed["t_s"].to_numpy(), streamed["mmsi"].to_numpy()))
+    return streamed.iloc[order].reset_index(drop=True), stats, late
+
+
+def test_the_yacht_in_slabs_shorter_than_her_gaps_is_judged_as_in_one_go() -> None:
+    table = report_table(_yacht())
+    whole = segment_reports(table, empty_carry(), TrackParams())
+    assert whole.stats.sog_contradicted == 4
+    assert whole.kept["sog_kn"].isna().all()
+    kept, stats, late = _streamed(table, 5.0, TrackParams())
+    pd.testing.assert_frame_equal(kept, whole.kept)
+    assert stats == whole.stats
+    assert late == 3  # each report waits in the carry for the next
+
+
+@st.composite
+def _claims(draw) -> pd.DataFrame:
+    """A few vessels' reports, some from a fixed position, with SOGs true or not, COGs
+    steady or turning, and gaps from 3 s to beyond max_gap_s."""
+    frames = []
+    for vessel in range(draw(st.integers(1, 3))):
+        count = draw(st.integers(1, 25))
+        steps = draw(
+            st.lists(
+                st.sampled_from([3.0, 10.0, 30.0, 90.0, 200.0, 400.0]),
+                min_size=count,
+                max_size=count,
+            )
+        )
+        t = 1_000_000.0 + np.cumsum(steps)
+        moving = np.asarray(draw(st.lists(st.booleans(), min_size=count, max_size=count)))
+        north_m = np.cumsum(np.where(moving, 5.0 * np.asarray(steps), 0.0))
+        sog = draw(
+            st.lists(st.sampled_from([0.0, 9.7, 20.0, 102.2]), min_size=count, max_size=count)
+        )
+        cog = draw(st.lists(st.sampled_from([0.0, 10.0, 180.0]), min_size=count, max_size=count))
+        frames.append(
+            pd.DataFrame(
+                {
+                    "mmsi": np.full(count, 219_000_000 + vessel, dtype=np.int64),
+                    "t_s": t,
+                    "lat_deg": 57.0 + north_m / 111_320.0,
+                    "lon_deg": np.full(count, 10.0),
+                    "sog_kn": np.asarray(sog, dtype=float),
+                    "cog_deg": np.asarray(cog, dtype=float),
+                    "heading_deg": np.full(count, np.nan),
+                    "nav_status": np.full(count, 0.0),
+                }
+            )
+        )
+    return pd.concat(frames, ignore_index=True)
+
+
+@settings(max_examples=100, deadline=None)
+@given(reports_table=_claims(), slab_s=st.sampled_from([5.0, 20.0, 60.0, 300.0, 1000.0]))
+def test_sog_checks_in_slabs_are_those_of_one_go(reports_table, slab_s) -> None:
+    """Reports held past their slab for their next neighbour: the same SOGs nulled and the
+    same counts, whatever the slab length."""
+    params = TrackParams()
+    whole = segment_reports(reports_table, empty_carry(), params)
+    kept, stats, _ = _streamed(reports_table, slab_s, params)
+    pd.testing.assert_frame_equal(kept, whole.kept)
+    assert stats == whole.stats
+    # Every SOG here is reported: a null one in the kept reports was contradicted.
+    assert stats.sog_contradicted == int(whole.kept["sog_kn"].isna().sum())
+
+
+def test_the_ledger_counts_the_sogs_set_to_null(tmp_path: Path) -> None:
+    # The yacht in a DMA file beside a vessel passing at 10 kn: four SOGs dropped, their
+    # reports used, and no candidate pair.
+    yacht = [(f"12/11/2013 12:00:{s:02d}", YACHT, 57.0, 10.0, 102.2, 45.0) for s in (0, 30)]
+    yacht += [(f"12/11/2013 12:01:{s:02d}", YACHT, 57.0, 10.0, 102.2, 45.0) for s in (0, 30)]
+    deg_per_s = 10 * 1852 / 3600 / (111_320 * np.cos(np.radians(57.0)))
+    passer = [
+        (
+            f"12/11/2013 12:{s // 60:02d}:{s % 60:02d}",
+            219000010,
+            56.997,
+            9.99 + deg_per_s * s,
+            10.0,
+            90.0,
+        )
+        for s in range(0, 180, 10)
+    ]
+    path = write_dma(tmp_path / "yacht.csv", yacht + passer)
+    result = run_replay([path], write=False)
+    ledger = result.manifest["ledger"]
+    assert ledger["values_dropped"] == {"sog_contradicted": 4}
+    assert ledger["rows_used"] == len(yacht) + len(passer)
+    assert result.manifest["tracks"]["sog_contradicted"] == 4
+    assert result.counts.candidate_pairs == 0

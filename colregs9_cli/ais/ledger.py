@@ -28,6 +28,8 @@ class DropReason(StrEnum):
     """Why a value was dropped from a row that was kept (the row itself counts as used)."""
 
     IMPLAUSIBLE_DIMENSION = "implausible_dimension"
+    # A reported SOG that the vessel's own positions contradict (tracks.py, rule 3a).
+    SOG_CONTRADICTED = "sog_contradicted"
 
 
 @dataclass

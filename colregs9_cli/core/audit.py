@@ -1,21 +1,55 @@
-"""Audit facts beyond the paper (docs/design.md §5 Replay): did the pair pass within the data, how
-close, and what each vessel did before the closest approach.
+"""Audit facts beyond the paper (docs/design.md §5 Replay): what each vessel did before the
+closest approach, and whether it was what the rules ask.
 
 Every function works on one pair's steps from the trigger on (row 0 is the trigger), both
 vessels present at every step. The facts are three-valued (``Fact``): where the data stops
 before the closest approach the answer is ``insufficient-data``, never ``false``.
 
-- **The pass.** The pair is past at the first step after the trigger at which it is opening
-  (TCPA < 0). The data covers the closest approach when that step is in the data; the actual
-  minimum separation is then the least range from the trigger to it.
+- **The pass** is ``passing.py``'s: the range opened clearly past its least value.
 - **Conduct.** Up to the closest approach, a vessel *changed* when her course turned by at
   least ``course_change_deg`` from her first course that can be judged, or her speed changed
   by at least ``speed_change_frac`` of her speed at the trigger and by at least
   ``speed_change_min_kn`` (a slow vessel's SOG noise is a large fraction of it). A course is
   judged only at speeds of at least ``course_judged_above_kn``: below that COG is GPS noise.
-  The first change in time is her action (starboard turn, port turn, slowed, sped up). With
-  no change, and her course judged at fewer than half of the steps, the answer is
-  ``insufficient-data``: a slow vessel's turn cannot be seen in her COG.
+  The first change in time is her action (starboard turn, port turn, slowed, stopped, sped
+  up). A slowing is *stopped* when her speed, once slowed, falls below ``stopped_below_kn``
+  at any step up to the closest approach (rule 8(e): "take all way off"); its row is still
+  the row where the slowing began. With no change, and her course judged at fewer than half
+  of the steps, the answer is ``insufficient-data``: a slow vessel's turn cannot be seen in
+  her COG.
+- **The kind of action** (``action_as_rule_asks``). Whether the give-way vessel's action is
+  the kind the deciding rule asks for (judged on her first action only):
+
+  ============  ==================================  =====================================
+  deciding      as the rule asks                    not as the rule asks
+  ============  ==================================  =====================================
+  14 head-on    starboard turn (rule 14(a))         port turn, slowed, stopped, sped up,
+                                                    none
+  15 crossing   starboard turn, slowed, stopped     port turn, sped up ("avoid crossing
+                (rules 15, 16, 8(e))                ahead", rule 15), none (rule 16)
+  13, 9, 18     a turn either way, slowed, stopped  sped up, none
+  ============  ==================================  =====================================
+
+  Rules 13 ("keep out of the way"), 9(b)–(d) ("not impede") and 18 ("keep out of the way")
+  name no side: which side is clear depends on where the other vessel is and on the water,
+  so either turn is of the kind they ask; whether the pass was in fact clear is the separate
+  ``passing.Passing.min_separation_m``. Rule 14(a) names the alteration to starboard: a slowing may
+  go with it, but one that comes first is the action judged, and is not the alteration.
+  Speeding up is never of the kind: rule 8(e) names slackening speed,
+  stopping or reversing as the speed actions that avoid a collision or allow more time, and
+  a faster give-way vessel closes on the other and leaves both less time. No action is not
+  of the kind either: rule 16 asks every give-way vessel to "take early and substantial
+  action", and the trigger (CPA under ``cpa_req_m`` within ``tcpa_act_s``) says one was
+  needed. An action that is ``insufficient-data`` gives ``insufficient-data``; a vessel that
+  is not a give-way vessel, or a pair with no situation, gives ``None`` (not applicable).
+- **Rule 17(c)** (``stand_on_turned_to_port_for_vessel_on_port``). In a rule 15 crossing the
+  stand-on vessel that acts "shall, if the circumstances of the case admit, not alter course
+  to port for a vessel on her own port side". The fact is ``true`` when her action was a
+  port turn and the give-way vessel bore from her, at the trigger, more than 0° and less than
+  180° to port (relative bearing in (180°, 360°)). A rule 9 or 18 pair is not judged (``None``):
+  rule 17(c) binds two power-driven vessels in a crossing, and a rule 9 or 18 stand-on
+  vessel is in the channel or of another kind. Nor is a vessel that is not the stand-on
+  vessel of a crossing. A port turn with the bearing unknown is ``insufficient-data``.
 """
 
 from __future__ import annotations
@@ -28,7 +62,10 @@ from enum import StrEnum
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..units import signed_angle_deg
+from ..errors import ParameterError
+from ..units import signed_angle_deg, wrap_deg
+from .colregs import Role, Situation
+from .rule9 import DecidingRule
 
 
 class Fact(StrEnum):
@@ -45,37 +82,32 @@ class Action(StrEnum):
     STARBOARD_TURN = "starboard-turn"
     PORT_TURN = "port-turn"
     SLOWED = "slowed"
+    STOPPED = "stopped"  # slowed, and then below ``ConductParams.stopped_below_kn``
     SPED_UP = "sped-up"
     NONE = "none"
     INSUFFICIENT = "insufficient-data"
 
 
 @dataclass(frozen=True)
-class Passage:
-    """Where the pair passed: ``cpa_row`` is the row of the least range up to the pass."""
-
-    covers_cpa: bool
-    cpa_row: int | None
-    min_separation_m: float | None
-
-
-def passage(range_m: ArrayLike, tcpa_s: ArrayLike) -> Passage:
-    """The pass and the actual closest approach (module docstring)."""
-    ranges = np.asarray(range_m, dtype=float)
-    opening = np.flatnonzero(np.asarray(tcpa_s, dtype=float)[1:] < 0.0)
-    if len(opening) == 0:
-        return Passage(covers_cpa=False, cpa_row=None, min_separation_m=None)
-    past_row = int(opening[0]) + 1
-    cpa_row = int(np.nanargmin(ranges[: past_row + 1]))
-    return Passage(covers_cpa=True, cpa_row=cpa_row, min_separation_m=float(ranges[cpa_row]))
-
-
-@dataclass(frozen=True)
 class ConductParams:
+    """The thresholds of the module docstring.
+
+    ``stopped_below_kn`` (default 0.5 kn) is the replay's ``min_sog_kn``, below which a
+    vessel is not under way for the pair search; AIS SOG at rest sits under it (San Diego
+    fixture, status at anchor or moored: 99 % of reports ≤ 0.5 kn, the highest 0.6 kn).
+    """
+
     course_change_deg: float
     speed_change_frac: float
     speed_change_min_kn: float
     course_judged_above_kn: float
+    stopped_below_kn: float = 0.5
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.stopped_below_kn) and self.stopped_below_kn >= 0.0):
+            raise ParameterError(
+                f"[replay] stopped_below_kn = {self.stopped_below_kn!r}: give a number >= 0"
+            )
 
 
 @dataclass(frozen=True)
@@ -110,7 +142,8 @@ def conduct(course_deg: ArrayLike, sog_kn: ArrayLike, params: ConductParams) -> 
             slowed = np.flatnonzero(sog <= trigger_speed - least_kn)
             sped_up = np.flatnonzero(sog >= trigger_speed + least_kn)
         if len(slowed):
-            events.append((int(slowed[0]), Action.SLOWED))
+            stopped = bool((sog[slowed] < params.stopped_below_kn).any())
+            events.append((int(slowed[0]), Action.STOPPED if stopped else Action.SLOWED))
         if len(sped_up):
             events.append((int(sped_up[0]), Action.SPED_UP))
     if events:
@@ -119,6 +152,83 @@ def conduct(course_deg: ArrayLike, sog_kn: ArrayLike, params: ConductParams) -> 
     if judged.mean() < 0.5:
         return INSUFFICIENT_CONDUCT
     return Conduct(Fact.FALSE, Action.NONE, None)
+
+
+# The kinds of action each deciding rule asks of the give-way vessel (module docstring).
+_KEEPS_OUT_OF_THE_WAY = frozenset(
+    {Action.STARBOARD_TURN, Action.PORT_TURN, Action.SLOWED, Action.STOPPED}
+)
+_KINDS_ASKED: dict[DecidingRule, frozenset[Action]] = {
+    DecidingRule.RULE_14: frozenset({Action.STARBOARD_TURN}),
+    DecidingRule.RULE_15: frozenset({Action.STARBOARD_TURN, Action.SLOWED, Action.STOPPED}),
+    DecidingRule.RULE_13: _KEEPS_OUT_OF_THE_WAY,
+    DecidingRule.RULE_9: _KEEPS_OUT_OF_THE_WAY,
+    DecidingRule.RULE_18: _KEEPS_OUT_OF_THE_WAY,
+}
+# rule9.decide_pair: rules 13-15 decide only their own situation, and rule 13 keeps the
+# roles of every overtaking, so rules 9 and 18 never decide one.
+_SITUATIONS_DECIDED: dict[DecidingRule, frozenset[Situation]] = {
+    DecidingRule.RULE_13: frozenset({Situation.OVERTAKING}),
+    DecidingRule.RULE_14: frozenset({Situation.HEAD_ON}),
+    DecidingRule.RULE_15: frozenset({Situation.CROSSING}),
+    DecidingRule.RULE_9: frozenset({Situation.HEAD_ON, Situation.CROSSING}),
+    DecidingRule.RULE_18: frozenset({Situation.HEAD_ON, Situation.CROSSING}),
+    DecidingRule.NONE: frozenset({Situation.NONE}),
+}
+
+
+def _decided(situation: Situation, deciding_rule: DecidingRule) -> tuple[Situation, DecidingRule]:
+    """The enums (from members or their strings); a pair rule9 cannot decide is a bug."""
+    situation, deciding_rule = Situation(situation), DecidingRule(deciding_rule)
+    if situation not in _SITUATIONS_DECIDED[deciding_rule]:
+        raise ValueError(f"rule {deciding_rule.value!r} does not decide a {situation} situation")
+    return situation, deciding_rule
+
+
+def action_as_rule_asks(
+    situation: Situation, deciding_rule: DecidingRule, role: Role, action: Action
+) -> Fact | None:
+    """Whether a vessel's action is of the kind the deciding rule asks of a give-way vessel.
+
+    ``role`` is her final role (``PairVerdict.role_final``). ``None`` where there is no
+    give-way action to judge: she is not a give-way vessel, or the pair has no situation.
+    Members or their strings (as in pairs.csv) are accepted.
+    """
+    situation, deciding_rule = _decided(situation, deciding_rule)
+    if deciding_rule is DecidingRule.NONE or Role(role) is not Role.GIVE_WAY:
+        return None
+    action = Action(action)
+    if action is Action.INSUFFICIENT:
+        return Fact.INSUFFICIENT
+    return Fact.of(action in _KINDS_ASKED[deciding_rule])
+
+
+def stand_on_turned_to_port_for_vessel_on_port(
+    situation: Situation,
+    deciding_rule: DecidingRule,
+    role: Role,
+    action: Action,
+    give_way_bearing_deg: float,
+) -> Fact | None:
+    """Rule 17(c) breached: the stand-on vessel of a rule 15 crossing turned to port for a
+    give-way vessel on her own port side.
+
+    ``give_way_bearing_deg`` is the give-way vessel's bearing from the stand-on vessel at the
+    trigger, clockwise from her course (the stand-on seat's ``beta_deg``); NaN when unknown.
+    ``None`` where rule 17(c) does not apply (module docstring).
+    """
+    situation, deciding_rule = _decided(situation, deciding_rule)
+    if deciding_rule is not DecidingRule.RULE_15 or Role(role) is not Role.STAND_ON:
+        return None
+    action = Action(action)
+    if action is Action.INSUFFICIENT:
+        return Fact.INSUFFICIENT
+    if action is not Action.PORT_TURN:
+        return Fact.FALSE
+    if not math.isfinite(give_way_bearing_deg):
+        return Fact.INSUFFICIENT
+    # dead ahead (0°) and dead astern (180°) are on neither side
+    return Fact.of(float(wrap_deg(give_way_bearing_deg)) > 180.0)
 
 
 def all_of(facts: Iterable[Fact]) -> Fact:

@@ -3,7 +3,9 @@
 1. Rate of swing (eq. ``rate_of_swing``): ``δ_swing = 360 / (2π r_turn)`` deg/m, from the 14
    reference vessels of the paper's Table "Overview of vessels used for calculation of rate of
    swing" (package data ``data/turning_circles.csv``), scaled (eq. ``rate_of_swing_scaled``) to
-   ``δ' = α·δ_swing`` with α ∈ [0, 1].
+   ``δ' = α·δ_swing`` with α ∈ [0, 1]. For real AIS, the ``length-scaled`` model gives each
+   vessel the turning radius of IMO MSC.137(76)'s turning-ability bound, ``r_turn = 2.5·L``
+   (``SwingModel`` and ``target_rate_of_swing_deg_per_m``).
 2. Turning arcs (eqs. ``pprime``, ``p'_body``, ``psi'``, ``r``): with ``r = 1/δ'`` (δ' in rad/m)
    and path length ``l_k = v·k·Δt`` for k = 1 … horizon/Δt, the heading change is
    ``ψ'_k = l_k·δ'`` and the body-frame offset ``r·[sin ψ', ±(1 − cos ψ')]`` (forward,
@@ -61,6 +63,15 @@ class SwingModel(StrEnum):
     FIXED = "fixed"
     NEAREST_LENGTH = "nearest-length"
     LOWER_BOUND = "lower-bound"
+    LENGTH_SCALED = "length-scaled"
+
+
+# IMO resolution MSC.137(76), Standards for ship manoeuvrability (2002), section 5.3.1: "the
+# tactical diameter should not exceed 5 ship lengths in the turning circle manoeuvre" (35°
+# rudder, or the maximum if less, deep water). The steady turning circle lies inside the
+# tactical diameter, so half of it bounds the turning radius of a ship that meets the standard.
+IMO_TACTICAL_DIAMETER_LENGTHS = 5.0
+TURN_RADIUS_LENGTHS = IMO_TACTICAL_DIAMETER_LENGTHS / 2.0
 
 
 class RestrictionPolicy(StrEnum):
@@ -91,13 +102,19 @@ def _positive(name: str, value: float, unit: str) -> None:
 
 @dataclass(frozen=True)
 class ManoeuvrabilityParams:
-    """Parameters of the estimator; defaults are the paper's Table "Simulation parameters".
+    """Parameters of the estimator; defaults are the paper's Table "Simulation parameters",
+    but for the swing model: ``length-scaled`` (a turning radius of 2.5 L, IMO MSC.137(76))
+    suits real AIS, where vessels of 5 m to 400 m meet; the paper's ``fixed`` 0.2 deg/m gives
+    every vessel a 716 m radius (with α 0.4), a setting for its case study, which keeps it
+    (``data/demo/greenhopper.toml``).
 
     ``swing_deg_per_m`` is the rate of swing of the ``fixed`` model (the paper: 0.2 deg/m);
-    ``horizon_s`` is the look-ahead (the paper's TCPA_act, 180 s) at ``step_s``.
+    ``horizon_s`` is the look-ahead (the paper's TCPA_act, 180 s) at ``step_s``. ``alpha``
+    scales every model's δ_swing alike: it is the fraction of the vessel's hard-over turning
+    ability that the arcs use (the paper's eq. ``rate_of_swing_scaled``).
     """
 
-    swing_model: SwingModel = SwingModel.FIXED
+    swing_model: SwingModel = SwingModel.LENGTH_SCALED
     swing_deg_per_m: float = 0.2
     alpha: float = 0.4
     horizon_s: float = 180.0
@@ -188,9 +205,21 @@ def target_rate_of_swing_deg_per_m(length_m: float | None, params: Manoeuvrabili
     - ``lower-bound``: the table's minimum, 360/(2π·740.8 m) ≈ 0.077 deg/m (the 363.6 m bulk
       carrier). The paper reads "≈ 0.1 deg/m" off its figure as the lower bound; the table's
       exact minimum is used here.
+    - ``length-scaled``: ``360 / (2π · 2.5·L)``, the turning radius of ``imo_turn_radius_m``,
+      so that a vessel turns in proportion to her size (a 12 m yacht 30 m, a 300 m ship
+      750 m). An unknown length falls back to ``lower-bound``, as for ``nearest-length``; in a
+      replay the length is never unknown, since ``core.vessel_defaults`` fills it in (and
+      names it in ``defaulted``). A length that is not positive is a ``ParameterError``.
     """
     if params.swing_model is SwingModel.FIXED:
         return params.swing_deg_per_m
+    if (
+        params.swing_model is SwingModel.LENGTH_SCALED
+        and length_m is not None
+        and math.isfinite(length_m)
+    ):
+        _positive("target length_m", length_m, "m")
+        return float(rate_of_swing_deg_per_m(imo_turn_radius_m(length_m)))
     lengths, rates = _reference_lengths_and_rates()
     if (
         params.swing_model is SwingModel.LOWER_BOUND
@@ -201,6 +230,32 @@ def target_rate_of_swing_deg_per_m(length_m: float | None, params: Manoeuvrabili
     gap = np.abs(lengths - length_m)
     nearest = gap == gap.min()
     return float(rates[nearest].min())
+
+
+def imo_turn_radius_m(length_m: ArrayLike) -> NDArray[np.float64]:
+    """The hard-over turning radius of the ``length-scaled`` model: ``2.5 · L``.
+
+    Half of MSC.137(76)'s largest tactical diameter, 5 L (``TURN_RADIUS_LENGTHS``). The
+    standard measures L between perpendiculars in deep water; AIS gives the length overall,
+    a few per cent longer, so the radius errs to the wide side. The standard covers ships
+    of 100 m and over: for small craft the same ratio is an extrapolation.
+    """
+    return TURN_RADIUS_LENGTHS * np.asarray(length_m, dtype=float)
+
+
+def scaled_rate_of_swing_deg_per_m(length_m: float | None, params: ManoeuvrabilityParams) -> float:
+    """δ' = α·δ_swing (deg/m), the rate of swing the turning arcs actually use."""
+    return params.alpha * target_rate_of_swing_deg_per_m(length_m, params)
+
+
+def arc_turn_radius_m(length_m: float | None, params: ManoeuvrabilityParams) -> float:
+    """The radius of the turning arcs projected for a vessel: ``1 / δ'`` with δ' in rad/m.
+
+    ``inf`` when α = 0 (the arcs run straight ahead). For ``length-scaled`` it is
+    ``2.5·L / α``; for ``fixed`` it is the same for every vessel (the paper: 716.2 m).
+    """
+    rate = scaled_rate_of_swing_deg_per_m(length_m, params)
+    return 1.0 / math.radians(rate) if rate > 0.0 else math.inf
 
 
 @dataclass(frozen=True)
@@ -461,7 +516,7 @@ def assess_manoeuvrability(
         breadth_m=breadth_m,
         draught_m=draught_m,
     )
-    rate = params.alpha * target_rate_of_swing_deg_per_m(length_m, params)
+    rate = scaled_rate_of_swing_deg_per_m(length_m, params)
     arcs = turning_arcs(
         north_m, east_m, course_deg, speed_mps, rate, params.horizon_s, params.step_s
     )
@@ -523,13 +578,12 @@ def unplaced_assessment(
     reach, where no chart is): ``unknown``, with no projected positions."""
     length_m, breadth_m = dimensions.length_m, dimensions.breadth_m
     draught_m = dimensions.draught_m
-    rate = params.alpha * target_rate_of_swing_deg_per_m(length_m, params)
     empty = np.empty(0, dtype=float)
     return ManoeuvrabilityAssessment(
         restriction=Restriction.UNKNOWN,
         policy=params.policy,
-        rate_of_swing_deg_per_m=rate,
-        turn_radius_m=1.0 / math.radians(rate) if rate > 0.0 else math.inf,
+        rate_of_swing_deg_per_m=scaled_rate_of_swing_deg_per_m(length_m, params),
+        turn_radius_m=arc_turn_radius_m(length_m, params),
         arc=np.empty(0, dtype=str),
         step=np.empty(0, dtype=np.int64),
         north_m=empty,

@@ -37,13 +37,33 @@ import pandas as pd
 
 from ..charts.water import Chart
 from ..geo import sail
-from .audit import INSUFFICIENT_CONDUCT, Conduct, ConductParams, conduct
+from .ais_claims import NavStatusBelief, NavStatusParams, nav_status_belief
+from .audit import (
+    INSUFFICIENT_CONDUCT,
+    Conduct,
+    ConductParams,
+    Fact,
+    action_as_rule_asks,
+    all_of,
+    conduct,
+    stand_on_turned_to_port_for_vessel_on_port,
+)
 from .colregs import ColregsEvaluation, ColregsParams, Kinematics, Role, evaluate_colregs
 from .encounters import Encounter, EncounterParams, encounter_series
+from .hull import UNKNOWN_OFFSETS, HullOffsets, centred_offsets, least_hull_distance_geodetic_m
+from .interactions import (
+    Interaction,
+    InteractionKind,
+    InteractionParams,
+    VesselFacts,
+    classify_interaction,
+    window_steps,
+)
 from .manoeuvrability import (
     ManoeuvrabilityAssessment,
     ManoeuvrabilityParams,
     Restriction,
+    SwingModel,
     VesselState,
     assess_manoeuvrability,
     unplaced_assessment,
@@ -71,6 +91,8 @@ class PairParams:
     rule9: Rule9Params
     dimensions: DimensionDefaults
     passing: PassingParams
+    interactions: InteractionParams
+    claims: NavStatusParams
 
 
 @dataclass(frozen=True)
@@ -81,6 +103,7 @@ class VesselAtTrigger:
     name: str | None
     dimensions: VesselDimensions
     nav_status: int | None
+    nav_status_belief: NavStatusBelief
     course_deg: float
     speed_kn: float
     lat_deg: float
@@ -90,6 +113,11 @@ class VesselAtTrigger:
     estimated_restricted: Restriction
     conduct: Conduct
     action_before_cpa_s: float | None
+
+    @property
+    def nav_status_used(self) -> int | None:
+        """Her status at the trigger as rules 9 and 18 use it: None when not believed."""
+        return self.nav_status if self.nav_status_belief.believed else None
 
 
 @dataclass(frozen=True)
@@ -114,6 +142,39 @@ class PairAudit:
     cpa_utc: pd.Timestamp | None
     conducts: tuple[Conduct, Conduct]
     before_cpa_s: tuple[float | None, float | None]
+    min_hull_separation_m: float | None = None
+
+
+def hull_offsets(dimensions: VesselDimensions) -> HullOffsets:
+    """A vessel's hull around her antenna from her reported length and breadth, the antenna
+    assumed amidships on the centre line (the canonical schema does not yet carry AIS's
+    A/B/C/D); unknown when either dimension was not reported (a table default is no hull)."""
+    if "length_m" in dimensions.defaulted or "breadth_m" in dimensions.defaulted:
+        return UNKNOWN_OFFSETS
+    return centred_offsets(dimensions.length_m, dimensions.breadth_m)
+
+
+def least_hull_separation_m(
+    window: pd.DataFrame, dimensions: tuple[VesselDimensions, VesselDimensions]
+) -> float | None:
+    """The least distance between the two hull outlines over ``window`` (rows of the pair's
+    series, headings true: COG where the heading was not reported); None where a hull is
+    unknown."""
+    offsets = tuple(hull_offsets(d) for d in dimensions)
+    if not all(o.known for o in offsets) or window.empty:
+        return None
+    a, b = PREFIXES
+    distance = least_hull_distance_geodetic_m(
+        window[f"{a}lat_deg"],
+        window[f"{a}lon_deg"],
+        window[f"{a}heading_deg"],
+        offsets[0],
+        window[f"{b}lat_deg"],
+        window[f"{b}lon_deg"],
+        window[f"{b}heading_deg"],
+        offsets[1],
+    )
+    return float(np.nanmin(distance)) if np.isfinite(distance).any() else None
 
 
 @dataclass(frozen=True)
@@ -131,6 +192,14 @@ class PairEvaluation:
     audit: PairAudit
     full: pd.DataFrame
     restricted_nav_statuses: frozenset[int]
+    interaction: Interaction
+    swing_model: SwingModel
+
+    @property
+    def is_encounter(self) -> bool:
+        """Only an encounter gets a situation, roles, rules 9 and 18 and the audit facts
+        (``interactions.py``); the others keep their geometry."""
+        return self.interaction.kind is InteractionKind.ENCOUNTER
 
     @property
     def verdict(self) -> PairVerdict:
@@ -153,9 +222,55 @@ class PairEvaluation:
             self.verdict,
             (a.dimensions, b.dimensions),
             (a.estimated_restricted, b.estimated_restricted),
-            (a.nav_status, b.nav_status),
+            (a.nav_status_used, b.nav_status_used),
             self.restricted_nav_statuses,
         )
+
+    @property
+    def give_way_action_as_rule_asks(self) -> Fact | None:
+        """Whether every give-way vessel's action is of the kind the deciding rule asks for
+        (``audit.action_as_rule_asks``); None without a give-way vessel."""
+        verdict = self.verdict
+        facts = [
+            action_as_rule_asks(
+                verdict.situation, verdict.deciding_rule, role, vessel.conduct.action
+            )
+            for vessel, role in zip(self.vessels, verdict.role_final, strict=True)
+        ]
+        judged = [fact for fact in facts if fact is not None]
+        return all_of(judged) if judged else None
+
+    @property
+    def stand_on_turned_to_port(self) -> Fact | None:
+        """Rule 17(c): the stand-on vessel of a crossing turned to port for a vessel on her own
+        port side (``audit.stand_on_turned_to_port_for_vessel_on_port``); None where it does
+        not apply. The other vessel's bearing is the one at the trigger, from her course."""
+        verdict = self.verdict
+        bearings = (self.steps.g_a.beta_deg[0], self.steps.g_a.beta_prime_deg[0])
+        facts = [
+            stand_on_turned_to_port_for_vessel_on_port(
+                verdict.situation,
+                verdict.deciding_rule,
+                role,
+                vessel.conduct.action,
+                float(bearing),
+            )
+            for vessel, role, bearing in zip(
+                self.vessels, verdict.role_final, bearings, strict=True
+            )
+        ]
+        judged = [fact for fact in facts if fact is not None]
+        return all_of(judged) if judged else None
+
+    @property
+    def turn_radius_m(self) -> tuple[float | None, float | None]:
+        """The radius of each vessel's projected arcs at the trigger; None where none were
+        projected (no place in the run's frame)."""
+        radii = tuple(
+            assessment.turn_radius_m if len(assessment.north_m) else None
+            for assessment in self.steps.trigger_assessments
+        )
+        return radii[0], radii[1]
 
     def with_role(self, role: Role) -> list[VesselAtTrigger]:
         """The vessels whose final role is ``role``, in vessel order."""
@@ -205,6 +320,40 @@ class Seat:
     @property
     def encounter_id(self) -> str:
         return f"{self.pair.encounter.start:%Y%m%dT%H%M%S}-{self.own.mmsi}-{self.target.mmsi}"
+
+
+@dataclass(frozen=True)
+class _Claims:
+    """Judges a vessel's navigational status claims against what else AIS says of her."""
+
+    ship_type: str | None
+    length_m: float | None
+    draught_m: float | None
+    params: NavStatusParams
+
+    @classmethod
+    def of(
+        cls, static: dict[str, Any], dimensions: VesselDimensions, params: NavStatusParams
+    ) -> _Claims:
+        """From her static AIS; a dimension the table defaulted is unknown here."""
+
+        def reported(name: str) -> float | None:
+            return None if name in dimensions.defaulted else getattr(dimensions, name)
+
+        ship_type = static.get("ship_type")
+        return cls(
+            None if ship_type is None else str(ship_type),
+            reported("length_m"),
+            reported("draught_m"),
+            params,
+        )
+
+    def belief(self, status: int | None) -> NavStatusBelief:
+        return nav_status_belief(status, self.ship_type, self.length_m, self.draught_m, self.params)
+
+    def used(self, status: int | None) -> int | None:
+        """``status`` where believed, else None: an implausible claim decides nothing."""
+        return status if self.belief(status).believed else None
 
 
 def text_or_none(value: Any) -> str | None:
@@ -318,6 +467,7 @@ def _held(g_a: ColregsEvaluation) -> ColregsEvaluation:
 def _pair_steps(
     series: pd.DataFrame,
     dimensions: tuple[VesselDimensions, VesselDimensions],
+    claims: tuple[_Claims, _Claims],
     chart: Chart | None,
     params: PairParams,
     step_s: float,
@@ -337,7 +487,10 @@ def _pair_steps(
         _Estimator(chart, params.manoeuvrability, dims, reassess) for dims in dimensions
     )
     states = tuple(_state(series, prefix) for prefix in PREFIXES)
-    nav = tuple([nav_status(v) for v in series[f"{p}nav_status"].tolist()] for p in PREFIXES)
+    nav = tuple(
+        [judge.used(nav_status(v)) for v in series[f"{p}nav_status"].tolist()]
+        for judge, p in zip(claims, PREFIXES, strict=True)
+    )
     estimates: tuple[list[Restriction], list[Restriction]] = ([], [])
     assessed_row: tuple[list[int], list[int]] = ([], [])
     verdicts: list[PairVerdict] = []
@@ -404,12 +557,19 @@ def rests_on_defaults(
     return False
 
 
-def _audit(window: pd.DataFrame, seen: Passing, params: ConductParams, step_s: float) -> PairAudit:
+def _audit(
+    window: pd.DataFrame,
+    seen: Passing,
+    dimensions: tuple[VesselDimensions, VesselDimensions],
+    params: ConductParams,
+    step_s: float,
+) -> PairAudit:
     if seen.cpa_row is None:
         return PairAudit(
             False, None, None, (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT), (None, None)
         )
     cpa_utc = window["timestamp"].iloc[seen.cpa_row]
+    hull_m = least_hull_separation_m(window.iloc[: seen.end_row + 1], dimensions)
     if not seen.covers_cpa:
         # The least range so far is observed, but the closest approach may lie past the data:
         # what the vessels did before it cannot be judged.
@@ -419,6 +579,7 @@ def _audit(window: pd.DataFrame, seen: Passing, params: ConductParams, step_s: f
             cpa_utc,
             (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT),
             (None, None),
+            hull_m,
         )
     until = window.iloc[: seen.cpa_row + 1]
     conducts = tuple(
@@ -438,6 +599,7 @@ def _audit(window: pd.DataFrame, seen: Passing, params: ConductParams, step_s: f
         cpa_utc=cpa_utc,
         conducts=(conducts[0], conducts[1]),
         before_cpa_s=(before[0], before[1]),
+        min_hull_separation_m=hull_m,
     )
 
 
@@ -460,7 +622,6 @@ def evaluate_pair(
     full = full.iloc[: _contiguous_rows(full["step"].to_numpy())].reset_index(drop=True)
     window = full[full["step"] >= encounter.trigger_step].reset_index(drop=True)
     seen = passing(window["range_m"].to_numpy(), params.passing)
-    audit = _audit(window, seen, params.conduct, step_s)
     # G_a and G_d run until the pair is past: until the range has opened clearly past its
     # least value (core/passing.py), or the data ends.
     series = window.iloc[: seen.end_row + 1]
@@ -468,10 +629,16 @@ def evaluate_pair(
         vessel_dimensions(_static(tracks.vessels, a), params.dimensions),
         vessel_dimensions(_static(tracks.vessels, b), params.dimensions),
     )
-    steps = _pair_steps(series, dimensions, chart, params, step_s)
+    claims = (
+        _Claims.of(_static(tracks.vessels, a), dimensions[0], params.claims),
+        _Claims.of(_static(tracks.vessels, b), dimensions[1], params.claims),
+    )
+    audit = _audit(window, seen, dimensions, params.conduct, step_s)
+    interaction = _interaction(tracks, oriented, encounter.trigger_step, params.interactions)
+    steps = _pair_steps(series, dimensions, claims, chart, params, step_s)
     trigger = series.iloc[0]
     vessels = tuple(
-        _vessel_at_trigger(tracks, mmsi, prefix, trigger, dimensions[i], steps, audit, i)
+        _vessel_at_trigger(tracks, mmsi, prefix, trigger, dimensions[i], claims[i], steps, audit, i)
         for i, (mmsi, prefix) in enumerate(zip((a, b), PREFIXES, strict=True))
     )
     return PairEvaluation(
@@ -481,7 +648,29 @@ def evaluate_pair(
         audit=audit,
         full=full,
         restricted_nav_statuses=params.rule9.restricted_nav_statuses,
+        interaction=interaction,
+        swing_model=params.manoeuvrability.swing_model,
     )
+
+
+def _interaction(
+    tracks: Tracks, pair: Encounter, trigger_step: int, params: InteractionParams
+) -> Interaction:
+    """What the two vessels were doing around the trigger (``interactions.py``), judged on a
+    window from before the candidate run: a ferry leaving her berth is slow until then."""
+    lead = window_steps(params, tracks.step_s)
+    around = encounter_series(
+        pair_tracks(tracks, (pair.own_mmsi, pair.target_mmsi)),
+        pair,
+        from_step=trigger_step - lead,
+        to_step=trigger_step + lead,
+    ).reset_index(drop=True)
+    trigger_row = int(np.searchsorted(around["step"].to_numpy(), trigger_step))
+    facts = tuple(
+        VesselFacts.from_static(mmsi, _static(tracks.vessels, mmsi))
+        for mmsi in (pair.own_mmsi, pair.target_mmsi)
+    )
+    return classify_interaction(around, trigger_row, (facts[0], facts[1]), params, tracks.step_s)
 
 
 def _vessel_at_trigger(
@@ -490,6 +679,7 @@ def _vessel_at_trigger(
     prefix: str,
     trigger: pd.Series,
     dimensions: VesselDimensions,
+    claims: _Claims,
     steps: PairSteps,
     audit: PairAudit,
     index: int,
@@ -508,6 +698,7 @@ def _vessel_at_trigger(
         name=name,
         dimensions=dimensions,
         nav_status=nav_status(trigger[f"{prefix}nav_status"]),
+        nav_status_belief=claims.belief(nav_status(trigger[f"{prefix}nav_status"])),
         course_deg=float(trigger[f"{prefix}course_deg"]),
         speed_kn=float(trigger[f"{prefix}sog_kn"]),
         lat_deg=float(trigger[f"{prefix}lat_deg"]),

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from ..geo import LocalFrame, velocity_mps
+from .interactions import InteractionKind
 from .manoeuvrability import ManoeuvrabilityAssessment
 from .pair import PairEvaluation, PairParams, Seat
 from .rows import EncounterSummary, PairSummary, pair_row, seat_row, seat_series
@@ -77,6 +78,17 @@ class ReplayResult:
     manifest: dict[str, Any]
     files: tuple[Path, ...]
     text: str = ""  # the summary printed to stdout (report.replay_report.format_summary)
+
+    @property
+    def interaction_summary(self) -> str:
+        """E.g. ``19 pairs: 17 encounters, 2 not-making-way``: the pairs by interaction."""
+        kinds = [pair.summary.interaction for pair in self.pairs]
+        parts = [
+            f"{kinds.count(kind)} {'encounters' if kind is InteractionKind.ENCOUNTER else kind}"
+            for kind in InteractionKind
+            if kind in kinds
+        ]
+        return f"{len(kinds)} pairs" + (": " + ", ".join(parts) if parts else "")
 
     @property
     def encounters(self) -> tuple[EncounterOutcome, ...]:

@@ -12,14 +12,15 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import pandas as pd
 
 from .audit import Action, Fact, all_of, negated
 from .colregs import Role, Situation, SituationBasis
-from .manoeuvrability import Restriction
-from .pair import PairEvaluation, Seat, reports_restricted
+from .interactions import InteractionKind
+from .manoeuvrability import Restriction, SwingModel
+from .pair import PairEvaluation, Seat, VesselAtTrigger, reports_restricted
 from .rule9 import DecidingRule
 
 
@@ -36,24 +37,33 @@ class PairSummary:
     start_utc: pd.Timestamp
     trigger_utc: pd.Timestamp
     end_utc: pd.Timestamp
-    situation: Situation
-    situation_ambiguous: bool
-    situation_basis: SituationBasis
-    role_colregs_a: Role
-    role_colregs_b: Role
+    interaction: InteractionKind
+    interaction_basis: str
+    situation: Situation | None
+    situation_ambiguous: bool | None
+    situation_basis: SituationBasis | None
+    role_colregs_a: Role | None
+    role_colregs_b: Role | None
     nav_status_a: int | None
     nav_status_b: int | None
-    estimated_restricted_a: Restriction
-    estimated_restricted_b: Restriction
-    automaton_path_a: str
-    automaton_path_b: str
-    rule9_applied: bool
-    deciding_rule: DecidingRule
-    both_restricted: bool
-    role_final_a: Role
-    role_final_b: Role
-    give_way_vessels: str
-    verdict_rests_on_defaults: bool
+    nav_status_believed_a: bool | None
+    nav_status_believed_b: bool | None
+    nav_status_doubt_a: str
+    nav_status_doubt_b: str
+    estimated_restricted_a: Restriction | None
+    estimated_restricted_b: Restriction | None
+    swing_model: SwingModel | None
+    turn_radius_m_a: float | None
+    turn_radius_m_b: float | None
+    automaton_path_a: str | None
+    automaton_path_b: str | None
+    rule9_applied: bool | None
+    deciding_rule: DecidingRule | None
+    both_restricted: bool | None
+    role_final_a: Role | None
+    role_final_b: Role | None
+    give_way_vessels: str | None
+    verdict_rests_on_defaults: bool | None
     range_m_at_trigger: float
     cpa_m: float
     tcpa_s: float
@@ -68,12 +78,16 @@ class PairSummary:
     data_covers_cpa: bool
     actual_min_separation_m: float | None
     actual_min_separation_utc: pd.Timestamp | None
+    actual_min_separation_hull_m: float | None
+    hull_antenna_position_assumed: bool | None
     give_way_vessel_acted: Fact | None
-    give_way_action: str
-    action_before_cpa_s: str
+    give_way_action: str | None
+    give_way_action_as_rule_asks: Fact | None
+    action_before_cpa_s: str | None
     stand_on_vessel_kept_course: Fact | None
-    action_a: Action
-    action_b: Action
+    stand_on_turned_to_port_for_vessel_on_port: Fact | None
+    action_a: Action | None
+    action_b: Action | None
     length_m_a: float
     breadth_m_a: float
     draught_m_a: float
@@ -85,6 +99,36 @@ class PairSummary:
 
 
 PAIR_COLUMNS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(PairSummary))
+# What only an encounter gets (interactions.py): empty for the other interactions.
+PAIR_VERDICT_COLUMNS: tuple[str, ...] = (
+    "situation",
+    "situation_ambiguous",
+    "situation_basis",
+    "role_colregs_a",
+    "role_colregs_b",
+    "estimated_restricted_a",
+    "estimated_restricted_b",
+    "swing_model",
+    "turn_radius_m_a",
+    "turn_radius_m_b",
+    "automaton_path_a",
+    "automaton_path_b",
+    "rule9_applied",
+    "deciding_rule",
+    "both_restricted",
+    "role_final_a",
+    "role_final_b",
+    "give_way_vessels",
+    "verdict_rests_on_defaults",
+    "give_way_vessel_acted",
+    "give_way_action",
+    "give_way_action_as_rule_asks",
+    "action_before_cpa_s",
+    "stand_on_vessel_kept_course",
+    "stand_on_turned_to_port_for_vessel_on_port",
+    "action_a",
+    "action_b",
+)
 
 
 @dataclass(frozen=True)
@@ -106,26 +150,32 @@ class EncounterSummary:
     start_utc: pd.Timestamp
     trigger_utc: pd.Timestamp
     end_utc: pd.Timestamp
-    situation: Situation
-    situation_ambiguous: bool
-    situation_basis: SituationBasis
-    own_role_colregs: Role
-    target_role_colregs: Role
+    interaction: InteractionKind
+    interaction_basis: str
+    situation: Situation | None
+    situation_ambiguous: bool | None
+    situation_basis: SituationBasis | None
+    own_role_colregs: Role | None
+    target_role_colregs: Role | None
     own_nav_status: int | None
     target_nav_status: int | None
+    own_nav_status_believed: bool | None
+    target_nav_status_believed: bool | None
+    own_nav_status_doubt: str
+    target_nav_status_doubt: str
     target_reports_restricted: bool
-    target_estimated_restricted: Restriction
-    own_estimated_restricted: Restriction
-    automaton_path: str
-    target_seat_automaton_path: str
-    rule9_applied: bool
-    deciding_rule: DecidingRule
-    both_restricted: bool
-    own_role_final: Role
-    target_role_final: Role
-    give_way_vessel: str
-    give_way_vessels: str
-    verdict_rests_on_defaults: bool
+    target_estimated_restricted: Restriction | None
+    own_estimated_restricted: Restriction | None
+    automaton_path: str | None
+    target_seat_automaton_path: str | None
+    rule9_applied: bool | None
+    deciding_rule: DecidingRule | None
+    both_restricted: bool | None
+    own_role_final: Role | None
+    target_role_final: Role | None
+    give_way_vessel: str | None
+    give_way_vessels: str | None
+    verdict_rests_on_defaults: bool | None
     range_m_at_trigger: float
     cpa_m: float
     tcpa_s: float
@@ -140,10 +190,14 @@ class EncounterSummary:
     data_covers_cpa: bool
     actual_min_separation_m: float | None
     actual_min_separation_utc: pd.Timestamp | None
+    actual_min_separation_hull_m: float | None
+    hull_antenna_position_assumed: bool | None
     give_way_vessel_acted: Fact | None
-    give_way_action: str
-    action_before_cpa_s: str
+    give_way_action: str | None
+    give_way_action_as_rule_asks: Fact | None
+    action_before_cpa_s: str | None
     stand_on_vessel_kept_course: Fact | None
+    stand_on_turned_to_port_for_vessel_on_port: Fact | None
     own_course_deg_at_trigger: float
     own_speed_kn_at_trigger: float
     target_course_deg_at_trigger: float
@@ -159,6 +213,48 @@ class EncounterSummary:
 
 
 ENCOUNTER_COLUMNS: tuple[str, ...] = tuple(f.name for f in dataclasses.fields(EncounterSummary))
+ENCOUNTER_VERDICT_COLUMNS: tuple[str, ...] = (
+    "situation",
+    "situation_ambiguous",
+    "situation_basis",
+    "own_role_colregs",
+    "target_role_colregs",
+    "target_estimated_restricted",
+    "own_estimated_restricted",
+    "automaton_path",
+    "target_seat_automaton_path",
+    "rule9_applied",
+    "deciding_rule",
+    "both_restricted",
+    "own_role_final",
+    "target_role_final",
+    "give_way_vessel",
+    "give_way_vessels",
+    "verdict_rests_on_defaults",
+    "give_way_vessel_acted",
+    "give_way_action",
+    "give_way_action_as_rule_asks",
+    "action_before_cpa_s",
+    "stand_on_vessel_kept_course",
+    "stand_on_turned_to_port_for_vessel_on_port",
+)
+# The series columns of the verdict, empty for the other interactions.
+SERIES_VERDICT_COLUMNS: tuple[str, ...] = (
+    "situation",
+    "own_role_colregs",
+    "target_role_colregs",
+    "own_estimated_restricted",
+    "target_estimated_restricted",
+    "own_assessed_utc",
+    "target_assessed_utc",
+    "automaton_state",
+    "automaton_path",
+    "target_seat_automaton_path",
+    "rule9_applied",
+    "deciding_rule",
+    "own_role_final",
+    "target_role_final",
+)
 
 # Per-vessel columns of a time series; each seat's series has them as own_* and target_*.
 SERIES_VESSEL_FIELDS: tuple[str, ...] = (
@@ -203,6 +299,31 @@ SERIES_COLUMNS: tuple[str, ...] = (
 )
 
 
+RowT = TypeVar("RowT", "PairSummary", "EncounterSummary")
+
+
+def situation_or_interaction(row: PairSummary | EncounterSummary) -> str:
+    """The situation of an encounter, else the kind of interaction (``in-company`` …): what
+    a report's situation column shows."""
+    return row.interaction.value if row.situation is None else row.situation.value
+
+
+def _blank(row: RowT, columns: Sequence[str]) -> RowT:
+    """``row`` with ``columns`` empty: the verdict of a pair that is not an encounter."""
+    empty: dict[str, Any] = dict.fromkeys(columns)
+    return dataclasses.replace(row, **empty)
+
+
+def _believed(vessel: VesselAtTrigger) -> bool | None:
+    """Whether her status at the trigger is believed; None when she reported none."""
+    return None if vessel.nav_status is None else vessel.nav_status_belief.believed
+
+
+def _doubt(vessel: VesselAtTrigger) -> str:
+    """Why her status is not believed (``ais_claims.py``); empty when it is."""
+    return "" if vessel.nav_status_belief.believed else vessel.nav_status_belief.reason
+
+
 def _mmsi_list(mmsis: Sequence[int]) -> str:
     return ";".join(str(m) for m in mmsis)
 
@@ -223,7 +344,7 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
     a, b = pair.vessels
     give_way = pair.with_role(Role.GIVE_WAY)
     stand_on = pair.with_role(Role.STAND_ON)
-    return PairSummary(
+    row = PairSummary(
         pair_id=pair.pair_id,
         mmsi_a=a.mmsi,
         mmsi_b=b.mmsi,
@@ -233,6 +354,8 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         start_utc=pair.encounter.start,
         trigger_utc=trigger["timestamp"],
         end_utc=pair.encounter.end,
+        interaction=pair.interaction.kind,
+        interaction_basis=pair.interaction.basis,
         situation=verdict.situation,
         situation_ambiguous=bool(held.ambiguous[0]),
         situation_basis=held.basis[0],
@@ -240,8 +363,15 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         role_colregs_b=verdict.role_colregs[1],
         nav_status_a=a.nav_status,
         nav_status_b=b.nav_status,
+        nav_status_believed_a=_believed(a),
+        nav_status_believed_b=_believed(b),
+        nav_status_doubt_a=_doubt(a),
+        nav_status_doubt_b=_doubt(b),
         estimated_restricted_a=a.estimated_restricted,
         estimated_restricted_b=b.estimated_restricted,
+        swing_model=pair.swing_model,
+        turn_radius_m_a=pair.turn_radius_m[0],
+        turn_radius_m_b=pair.turn_radius_m[1],
         automaton_path_a=verdict.seat_a.path_text,
         automaton_path_b=verdict.seat_b.path_text,
         rule9_applied=verdict.rule9_applied,
@@ -265,12 +395,18 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         data_covers_cpa=pair.audit.covers_cpa,
         actual_min_separation_m=pair.audit.min_separation_m,
         actual_min_separation_utc=pair.audit.cpa_utc,
+        actual_min_separation_hull_m=pair.audit.min_hull_separation_m,
+        hull_antenna_position_assumed=(
+            None if pair.audit.min_hull_separation_m is None else True  # no A/B/C/D yet
+        ),
         give_way_vessel_acted=all_of(v.conduct.changed for v in give_way) if give_way else None,
         give_way_action=_joined([v.conduct.action.value for v in give_way]),
+        give_way_action_as_rule_asks=pair.give_way_action_as_rule_asks,
         action_before_cpa_s=_joined([_seconds(v.action_before_cpa_s) for v in give_way]),
         stand_on_vessel_kept_course=(
             all_of(negated(v.conduct.changed) for v in stand_on) if stand_on else None
         ),
+        stand_on_turned_to_port_for_vessel_on_port=pair.stand_on_turned_to_port,
         action_a=a.conduct.action,
         action_b=b.conduct.action,
         length_m_a=a.dimensions.length_m,
@@ -282,6 +418,7 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         draught_m_b=b.dimensions.draught_m,
         defaulted_dimensions_b=b.dimensions.defaulted_text,
     )
+    return row if pair.is_encounter else _blank(row, PAIR_VERDICT_COLUMNS)
 
 
 def _give_way_side(own_role: Role, target_role: Role) -> str:
@@ -298,7 +435,7 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
     own_automaton, target_automaton = seat.automata(verdict)
     own_colregs, target_colregs = seat.mine(verdict.role_colregs)
     own_final, target_final = seat.mine(verdict.role_final)
-    return EncounterSummary(
+    row = EncounterSummary(
         encounter_id=seat.encounter_id,
         pair_id=pair.pair_id,
         own_mmsi=own.mmsi,
@@ -308,6 +445,8 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         start_utc=pair.start_utc,
         trigger_utc=pair.trigger_utc,
         end_utc=pair.end_utc,
+        interaction=pair.interaction,
+        interaction_basis=pair.interaction_basis,
         situation=pair.situation,
         situation_ambiguous=pair.situation_ambiguous,
         situation_basis=pair.situation_basis,
@@ -315,6 +454,10 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         target_role_colregs=target_colregs,
         own_nav_status=own.nav_status,
         target_nav_status=target.nav_status,
+        own_nav_status_believed=_believed(own),
+        target_nav_status_believed=_believed(target),
+        own_nav_status_doubt=_doubt(own),
+        target_nav_status_doubt=_doubt(target),
         target_reports_restricted=reports_restricted(
             target.nav_status, seat.pair.restricted_nav_statuses
         ),
@@ -344,10 +487,14 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         data_covers_cpa=pair.data_covers_cpa,
         actual_min_separation_m=pair.actual_min_separation_m,
         actual_min_separation_utc=pair.actual_min_separation_utc,
+        actual_min_separation_hull_m=pair.actual_min_separation_hull_m,
+        hull_antenna_position_assumed=pair.hull_antenna_position_assumed,
         give_way_vessel_acted=pair.give_way_vessel_acted,
         give_way_action=pair.give_way_action,
+        give_way_action_as_rule_asks=pair.give_way_action_as_rule_asks,
         action_before_cpa_s=pair.action_before_cpa_s,
         stand_on_vessel_kept_course=pair.stand_on_vessel_kept_course,
+        stand_on_turned_to_port_for_vessel_on_port=pair.stand_on_turned_to_port_for_vessel_on_port,
         own_course_deg_at_trigger=own.course_deg,
         own_speed_kn_at_trigger=own.speed_kn,
         target_course_deg_at_trigger=target.course_deg,
@@ -361,6 +508,7 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         target_draught_m=target.dimensions.draught_m,
         target_dimensions_defaulted=target.dimensions.defaulted_text,
     )
+    return row if seat.pair.is_encounter else _blank(row, ENCOUNTER_VERDICT_COLUMNS)
 
 
 def seat_series(seat: Seat) -> pd.DataFrame:
@@ -409,4 +557,7 @@ def seat_series(seat: Seat) -> pd.DataFrame:
         "own_role_final": [seat.mine(v.role_final)[0].value for v in steps.verdicts],
         "target_role_final": [seat.mine(v.role_final)[1].value for v in steps.verdicts],
     }
-    return pd.DataFrame(columns)[list(SERIES_COLUMNS)]
+    series_table = pd.DataFrame(columns)[list(SERIES_COLUMNS)]
+    if not seat.pair.is_encounter:
+        series_table[list(SERIES_VERDICT_COLUMNS)] = None
+    return series_table

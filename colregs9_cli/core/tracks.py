@@ -18,6 +18,13 @@ The rules, in order, per MMSI with reports sorted by time:
    it as ``RejectReason.SPEED_JUMP``) and the next report is tested against the same anchor.
 3. **Gaps.** A track is split where consecutive kept reports are more than ``max_gap_s`` apart
    (``gap_splits``).
+3a. **Contradicted SOG.** A reported SOG is set to null, so that rule 4 derives it from the
+   positions, where the vessel's own positions show she cannot have made it good
+   (``sog_contradicted``; the caller counts it in the ledger's ``values_dropped``): between
+   the report's neighbours in its segment (one-sided at a segment's end) she covered much
+   less ground than the SOG claims (``ais_claims.SogCheckParams``: a yacht reporting
+   102.2 kn from one fixed position). A SOG lower than the positions imply is kept: at low
+   speed that is what GNSS scatter does to positions (a moored vessel's fixes 100 m apart).
 4. **Missing SOG/COG.** A null SOG or COG is derived from the movement between the report's
    neighbours in its segment (previous to next report; one-sided at a segment's ends), turned
    from grid to true north at the report. A vessel that did not move gets SOG 0 and no COG
@@ -41,7 +48,7 @@ centred on all of Denmark, a CPA error of range·sin γ).
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import StrEnum
 
 import numpy as np
@@ -50,6 +57,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..geo import LocalFrame, ecef_m, normal_to_lat_lon, surface_normal, true_bearing_deg
 from ..units import MPS_PER_KNOT, signed_angle_deg, wrap_deg
+from .ais_claims import Fixes, SogCheckParams, contradicted_sog
 
 
 class CourseSource(StrEnum):
@@ -69,12 +77,14 @@ class TrackParams:
       this is an implausible jump (rule 2).
     - ``min_sog_kn``: vessels slower than this are not under way: their samples are counted
       apart, and only vessels under way are kept for the pair search.
+    - ``sog_check``: when a reported SOG is contradicted by the positions (rule 3a).
     """
 
     step_s: float = 1.0
     max_gap_s: float = 300.0
     max_speed_kn: float = 50.0
     min_sog_kn: float = 0.5
+    sog_check: SogCheckParams = field(default_factory=SogCheckParams)
 
 
 REQUIRED_COLUMNS: tuple[str, ...] = (
@@ -122,7 +132,8 @@ class TrackStats:
 
     ``samples`` counts the resampled samples at which a vessel is under way
     (SOG ≥ ``min_sog_kn``): the samples the pair search works on. It does not depend on how
-    the run is cut into slabs.
+    the run is cut into slabs. ``sog_contradicted`` counts the reported SOGs set to null by
+    rule 3a (their reports are used).
     """
 
     reports_in: int
@@ -133,6 +144,7 @@ class TrackStats:
     gap_splits: int
     segments: int
     samples: int
+    sog_contradicted: int
 
     def __add__(self, other: TrackStats) -> TrackStats:
         return TrackStats(
@@ -140,7 +152,7 @@ class TrackStats:
         )
 
 
-NO_TRACK_STATS = TrackStats(0, 0, 0, 0, 0, 0, 0, 0)
+NO_TRACK_STATS = TrackStats(0, 0, 0, 0, 0, 0, 0, 0, 0)
 
 
 @dataclass(frozen=True)
@@ -167,12 +179,15 @@ class Tracks:
         return pd.Timestamp(step * self.step_s, unit="s", tz="UTC")
 
 
-# -- rules 1-3: segmentation, in one go or slab by slab --------------------------------------
+# -- rules 1-3a: segmentation, in one go or slab by slab -------------------------------------
 #
 # A report's fate depends on the vessel's last kept report (the anchor) and, when it jumps,
 # on the report after it. So segmentation can run through time slab by slab and decide every
 # report exactly as in one go: each slab carries, per vessel, its anchor and at most one
-# report still pending (the slab's last, a jump that the next report may confirm).
+# report still pending (the slab's last, a jump that the next report may confirm). Rule 3a
+# judges a kept report's SOG by its neighbours: an anchor whose next kept report may still
+# come within ``SogCheckParams.max_gap_s`` is held (carried, not yet given out) with its
+# segment start and its previous kept report, and given out once its next is known.
 
 REPORT_COLUMNS: tuple[str, ...] = (
     "mmsi",
@@ -185,7 +200,20 @@ REPORT_COLUMNS: tuple[str, ...] = (
     "nav_status",
 )
 KEPT_COLUMNS: tuple[str, ...] = (*REPORT_COLUMNS, "segment_start")
-CARRY_COLUMNS: tuple[str, ...] = (*REPORT_COLUMNS, "pending")
+# A held anchor's previous kept report in its segment (NaN when none), for rule 3a.
+PREVIOUS_COLUMNS: tuple[str, ...] = (
+    "previous_t_s",
+    "previous_lat_deg",
+    "previous_lon_deg",
+    "previous_cog_deg",
+)
+CARRY_COLUMNS: tuple[str, ...] = (
+    *REPORT_COLUMNS,
+    "pending",
+    "held",
+    "segment_start",
+    *PREVIOUS_COLUMNS,
+)
 
 
 def report_table(positions: pd.DataFrame) -> pd.DataFrame:
@@ -217,7 +245,8 @@ def empty_carry() -> pd.DataFrame:
         {
             "mmsi": np.zeros(0, dtype=np.int64),
             **{name: np.zeros(0) for name in REPORT_COLUMNS[1:]},
-            "pending": np.zeros(0, dtype=bool),
+            **{name: np.zeros(0, dtype=bool) for name in ("pending", "held", "segment_start")},
+            **{name: np.zeros(0) for name in PREVIOUS_COLUMNS},
         }
     )
 
@@ -238,13 +267,20 @@ def segment_reports(
     params: TrackParams,
     until_s: float | None = None,
 ) -> Segmented:
-    """Rules 1-3 on ``reports`` (``REPORT_COLUMNS``), all earlier than ``until_s`` and later
+    """Rules 1-3a on ``reports`` (``REPORT_COLUMNS``), all earlier than ``until_s`` and later
     than every report of earlier slabs, continuing from ``carry``.
 
     ``until_s`` is where the next slab starts; ``None`` means the data ends here, and every
-    pending report is decided (a jump nothing confirms is dropped).
+    pending report is decided (a jump nothing confirms is dropped) and every held one given
+    out.
     """
-    rows = pd.concat([carry, reports.assign(pending=False)], ignore_index=True)
+    fresh_rows = reports.assign(
+        pending=False,
+        held=False,
+        segment_start=False,
+        **dict.fromkeys(PREVIOUS_COLUMNS, np.nan),
+    )
+    rows = pd.concat([carry, fresh_rows], ignore_index=True)
     carried = np.r_[np.ones(len(carry), dtype=bool), np.zeros(len(reports), dtype=bool)]
     mmsi_all = rows["mmsi"].to_numpy(dtype=np.int64)
     t_all = rows["t_s"].to_numpy(dtype=float)
@@ -273,6 +309,7 @@ def segment_reports(
     else:
         undecided &= t >= until_s - params.max_gap_s
     anchor = carried[order] & ~rows["pending"].to_numpy(dtype=bool)[order]
+    held = rows["held"].to_numpy(dtype=bool)[order]
 
     kept = keep.copy()
     first_of_vessel = np.ones(len(t), dtype=bool)
@@ -283,28 +320,87 @@ def segment_reports(
     first_of_vessel[kept_index] = first
     gap_at = np.zeros(len(t), dtype=bool)
     gap_at[kept_index] = gap
-    segment_start = first_of_vessel | gap_at | jump_split
-    emitted = kept & ~anchor
+    # A held anchor starts a segment as it did when it was kept.
+    carried_start = rows["segment_start"].to_numpy(dtype=bool)[order]
+    segment_start = np.where(held, carried_start, first_of_vessel | gap_at | jump_split)
+    newly_kept = kept & ~anchor
 
-    last_kept = kept_index[np.r_[kept_mmsi[1:] != kept_mmsi[:-1], True]]
+    last = np.r_[kept_mmsi[1:] != kept_mmsi[:-1], True]
+    last_kept = kept_index[last]
+    # Rule 3a: a vessel's last kept report, not given out yet, waits for its next while one
+    # may still come.
+    neighbour_gap_s = min(params.sog_check.max_gap_s, params.max_gap_s)
+    awaiting = np.zeros(len(t), dtype=bool)
+    if until_s is not None:
+        awaiting[last_kept] = t[last_kept] >= until_s - neighbour_gap_s
+    awaiting &= newly_kept | held
+    emitted = (newly_kept | held) & ~awaiting
+    own, previous, following = _neighbours(
+        rows, order, kept_index, first, last, segment_start, lat, lon
+    )
+    contradicted = np.zeros(len(t), dtype=bool)
+    contradicted[kept_index] = contradicted_sog(
+        rows["sog_kn"].to_numpy(dtype=float)[order[kept_index]],
+        own,
+        previous,
+        following,
+        params.sog_check,
+    )
+
     next_carry = np.zeros(len(t), dtype=bool)
     next_carry[last_kept] = True
     next_carry |= undecided
     out = rows.iloc[order[emitted]][list(REPORT_COLUMNS)].reset_index(drop=True)
+    out["sog_kn"] = np.where(contradicted[emitted], np.nan, out["sog_kn"].to_numpy(dtype=float))
     out["segment_start"] = segment_start[emitted]
     carry_rows = rows.iloc[order[next_carry]][list(REPORT_COLUMNS)].reset_index(drop=True)
     carry_rows["pending"] = undecided[next_carry]
+    carry_rows["held"] = awaiting[next_carry]
+    carry_rows["segment_start"] = segment_start[next_carry]
+    previous_table = np.full((len(t), len(PREVIOUS_COLUMNS)), np.nan)
+    previous_table[kept_index] = previous.table()
+    for column, name in enumerate(PREVIOUS_COLUMNS):
+        carry_rows[name] = previous_table[next_carry, column]
     stats = TrackStats(
         reports_in=len(reports),
-        reports_used=int(emitted.sum()),
+        reports_used=int(newly_kept.sum()),
         same_time_dropped=same_time_dropped,
         speed_jump_dropped=int((~keep & ~undecided).sum()),
-        jump_splits=int((jump_split & emitted).sum()),
-        gap_splits=int((gap_at & emitted).sum()),
-        segments=int((segment_start & emitted).sum()),
+        jump_splits=int((jump_split & newly_kept).sum()),
+        gap_splits=int((gap_at & newly_kept).sum()),
+        segments=int((segment_start & newly_kept).sum()),
         samples=0,
+        sog_contradicted=int((contradicted & emitted).sum()),
     )
     return Segmented(kept=out, carry=carry_rows, stats=stats)
+
+
+def _neighbours(
+    rows: pd.DataFrame,
+    order: NDArray[np.int64],
+    kept_index: NDArray[np.int64],
+    first: NDArray[np.bool_],
+    last: NDArray[np.bool_],
+    segment_start: NDArray[np.bool_],
+    lat_deg: NDArray[np.float64],
+    lon_deg: NDArray[np.float64],
+) -> tuple[Fixes, Fixes, Fixes]:
+    """The kept reports (``kept_index`` into the sorted ``order`` of ``rows``; ``first`` and
+    ``last`` of their vessel here) and their neighbours, the kept reports before and after
+    in the same segment (NaN: none, or not known yet); a carried anchor brings its previous
+    one with it."""
+    chosen = order[kept_index]
+
+    def column(name: str) -> NDArray[np.float64]:
+        return rows[name].to_numpy(dtype=float)[chosen]
+
+    own = Fixes(column("t_s"), lat_deg[kept_index], lon_deg[kept_index], column("cog_deg"))
+    starts = segment_start[kept_index]
+    index = np.arange(len(kept_index))
+    carried = Fixes(*(column(name) for name in PREVIOUS_COLUMNS))
+    previous = carried.where(first, own.take(np.maximum(index - 1, 0), ~first & ~starts))
+    following = own.take(np.minimum(index + 1, len(index) - 1), ~last & ~np.r_[starts[1:], False])
+    return own, previous, following
 
 
 # -- rules 4-5: motion and resampling of decided reports --------------------------------------

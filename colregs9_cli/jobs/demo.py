@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import shutil
 from dataclasses import dataclass
+from enum import Enum
 from importlib import resources
 from pathlib import Path
 
@@ -77,10 +78,10 @@ class ScenarioVerdict:
         expected = PAPER_VERDICTS.get(self.scenario)
         s = self.outcome.summary
         return expected is not None and expected == PaperVerdict(
-            s.target_estimated_restricted.value,
-            s.rule9_applied,
-            s.own_role_final.value,
-            s.automaton_path,
+            _shown(s.target_estimated_restricted),
+            bool(s.rule9_applied),
+            _shown(s.own_role_final),
+            _shown(s.automaton_path),
         )
 
 
@@ -94,8 +95,15 @@ class DemoResult:
         return format_demo(self)
 
 
-def _yes_no(value: bool) -> str:
-    return "yes" if value else "no"
+def _yes_no(value: bool | None) -> str:
+    return "-" if value is None else "yes" if value else "no"
+
+
+def _shown(value: Enum | str | None) -> str:
+    """A verdict value as printed; ``-`` where the pair is not an encounter and has none."""
+    if value is None:
+        return "-"
+    return value.value if isinstance(value, Enum) else value
 
 
 def verdict_rows(verdict: ScenarioVerdict) -> tuple[tuple[str, str], ...]:
@@ -103,13 +111,14 @@ def verdict_rows(verdict: ScenarioVerdict) -> tuple[tuple[str, str], ...]:
     s = verdict.outcome.summary
     return (
         ("trigger (UTC)", s.trigger_utc.strftime(DISPLAY_TIME_FORMAT)),
-        ("situation", s.situation.value),
-        ("own role under COLREGs", s.own_role_colregs.value),
+        ("interaction", s.interaction.value),
+        ("situation", _shown(s.situation)),
+        ("own role under COLREGs", _shown(s.own_role_colregs)),
         ("target reports restricted", _yes_no(s.target_reports_restricted)),
-        ("target estimated restricted", s.target_estimated_restricted.value),
+        ("target estimated restricted", _shown(s.target_estimated_restricted)),
         ("rule 9 applied", _yes_no(s.rule9_applied)),
-        ("own role after rule 9", s.own_role_final.value),
-        ("automaton path", s.automaton_path),
+        ("own role after rule 9", _shown(s.own_role_final)),
+        ("automaton path", _shown(s.automaton_path)),
         ("range at trigger", f"{s.range_m_at_trigger:.0f} m"),
         ("CPA at trigger", f"{s.cpa_m:.0f} m"),
         ("TCPA at trigger", f"{s.tcpa_s:.0f} s"),

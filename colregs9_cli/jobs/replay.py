@@ -30,7 +30,7 @@ from typing import Any
 import pandas as pd
 
 from ..ais.inputs import InputFile
-from ..ais.ledger import RejectReason, RejectsLedger
+from ..ais.ledger import DropReason, RejectReason, RejectsLedger
 from ..charts.provenance import charts_manifest
 from ..charts.sources import ChartSource, read_charts
 from ..charts.water import Chart, project_charts
@@ -126,12 +126,14 @@ def run_frame(query: Query, extent: Extent, chart: ChartSource | None = None) ->
 
 
 def _ledger_with_tracks(ledger: RejectsLedger, stats: TrackStats) -> RejectsLedger:
-    """The loader's ledger plus the reports that segmentation dropped."""
+    """The loader's ledger plus the reports that segmentation dropped, and the SOGs it set
+    to null (their reports are used)."""
     result = copy.deepcopy(ledger)
     dropped = stats.same_time_dropped + stats.speed_jump_dropped
     result.rows_used -= dropped
     result.reject(RejectReason.DUPLICATE, stats.same_time_dropped)
     result.reject(RejectReason.SPEED_JUMP, stats.speed_jump_dropped)
+    result.drop(DropReason.SOG_CONTRADICTED, stats.sog_contradicted)
     return result
 
 
@@ -400,24 +402,29 @@ def slab_context(
 
 
 def verdict_counts(pairs: Sequence[PairOutcome]) -> dict[str, Any]:
-    """The pairs' verdicts counted for run.json: by situation, deciding rule and audit fact."""
+    """The pairs counted for run.json: by interaction, and the encounters' verdicts by
+    situation, deciding rule and audit fact."""
 
     def count(values: Sequence[Any]) -> dict[str, int]:
         texts = ["" if v is None else str(getattr(v, "value", v)).lower() for v in values]
         return {key: texts.count(key) for key in sorted(set(texts))}
 
     summaries = [p.summary for p in pairs]
+    encounters = [s for s in summaries if s.situation is not None]
     return {
         "pairs": len(summaries),
-        "situation": count([s.situation for s in summaries]),
-        "situation_ambiguous": sum(s.situation_ambiguous for s in summaries),
-        "deciding_rule": count([s.deciding_rule for s in summaries]),
-        "rule9_applied": sum(s.rule9_applied for s in summaries),
-        "both_restricted": sum(s.both_restricted for s in summaries),
-        "verdict_rests_on_defaults": sum(s.verdict_rests_on_defaults for s in summaries),
+        "interaction": count([s.interaction for s in summaries]),
+        "encounters": len(encounters),
+        "situation": count([s.situation for s in encounters]),
+        "situation_ambiguous": sum(bool(s.situation_ambiguous) for s in encounters),
+        "deciding_rule": count([s.deciding_rule for s in encounters]),
+        "rule9_applied": sum(bool(s.rule9_applied) for s in encounters),
+        "both_restricted": sum(bool(s.both_restricted) for s in encounters),
+        "verdict_rests_on_defaults": sum(bool(s.verdict_rests_on_defaults) for s in encounters),
         "data_covers_cpa": sum(s.data_covers_cpa for s in summaries),
-        "give_way_vessel_acted": count([s.give_way_vessel_acted for s in summaries]),
+        "give_way_vessel_acted": count([s.give_way_vessel_acted for s in encounters]),
+        "give_way_action_as_rule_asks": count([s.give_way_action_as_rule_asks for s in encounters]),
         "estimated_restricted": count(
-            [e for s in summaries for e in (s.estimated_restricted_a, s.estimated_restricted_b)]
+            [e for s in encounters for e in (s.estimated_restricted_a, s.estimated_restricted_b)]
         ),
     }

@@ -14,12 +14,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from typing import Any
+from typing import Any, TypeVar
 
 from ..config import dataclass_from_table
+from ..core.ais_claims import NavStatusParams
 from ..core.audit import ConductParams
 from ..core.colregs import ColregsParams
 from ..core.encounters import EncounterParams
+from ..core.interactions import InteractionParams
 from ..core.manoeuvrability import ManoeuvrabilityParams
 from ..core.pair import PairParams
 from ..core.passing import PassingParams
@@ -28,6 +30,8 @@ from ..core.tracks import TrackParams
 from ..core.vessel_defaults import DimensionDefaults
 from ..errors import ParameterError
 from ..units import METRES_PER_NAUTICAL_MILE
+
+T = TypeVar("T")
 
 # The most steps one vessel may have in a slab's window: 13 float columns of 8 bytes make a
 # gigabyte per vessel at 1e7.
@@ -41,6 +45,11 @@ SLAB_MAX_S = 7 * 86_400.0
 # The least candidate range: below a metre the pair search's grid would be finer than any
 # AIS position.
 CANDIDATE_RANGE_MIN_M = 1.0
+
+
+def _stage_part(params: Any, stage: type[T]) -> T:
+    """A stage's parameters from the ``[replay]`` keys of the same names."""
+    return stage(**{f.name: getattr(params, f.name) for f in fields(stage)})  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)
@@ -84,6 +93,7 @@ class ReplayParams:
     speed_change_frac: float = 0.25
     speed_change_min_kn: float = 1.0
     course_judged_above_kn: float = 2.0
+    stopped_below_kn: float = 0.5
     restricted_nav_statuses: frozenset[int] = frozenset({3, 4})
     reassess_every_s: float = 10.0
     default_length_m: float | None = None
@@ -93,6 +103,19 @@ class ReplayParams:
     passing_open_m: float = 100.0
     passing_open_frac: float = 0.5
     passing_follow_s: float = 600.0
+    interaction_window_s: float = 120.0
+    speed_span_s: float = 30.0
+    making_way_kn: float = 1.0
+    at_rest_min_s: float = 30.0
+    alongside_margin_m: float = 10.0
+    alongside_min_s: float = 60.0
+    service_margin_m: float = 30.0
+    service_speed_kn: float = 1.0
+    service_min_s: float = 30.0
+    company_min_s: float = 120.0
+    company_course_deg: float = 20.0
+    company_drift_m: float = 30.0
+    company_drift_frac: float = 0.25
 
     @property
     def tracks(self) -> TrackParams:
@@ -111,7 +134,12 @@ class ReplayParams:
             self.speed_change_frac,
             self.speed_change_min_kn,
             self.course_judged_above_kn,
+            self.stopped_below_kn,
         )
+
+    @property
+    def interactions(self) -> InteractionParams:
+        return _stage_part(self, InteractionParams)
 
     @property
     def passing(self) -> PassingParams:
@@ -128,6 +156,7 @@ class ReplayParams:
         )
 
     def __post_init__(self) -> None:
+        _stage_part(self, InteractionParams)  # checks its own keys
         positive = (
             "step_s",
             "max_gap_s",
@@ -237,4 +266,6 @@ class ReplayRunParams:
             rule9=self.replay.rule9,
             dimensions=self.replay.dimension_defaults,
             passing=self.replay.passing,
+            interactions=self.replay.interactions,
+            claims=NavStatusParams(),
         )

@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 
 from ..charts.water import Chart
 from ..core.encounters import Encounter, find_encounters
+from ..core.interactions import window_steps
 from ..core.passing import horizon_steps
 from ..core.replay_results import PairOutcome
 from ..core.tracks import (
@@ -399,7 +400,9 @@ def replay_slab(
     params = job.params
     core = job.core_steps(slab)
     last_data_step = math.floor(job.data_end_s / params.step_s)
-    window = (core[0] - 1, core[1] + tail_steps(params))
+    # Before the core: the interaction is judged from before a trigger at the core's start.
+    lead = window_steps(params.interactions, params.step_s)
+    window = (core[0] - 1 - lead, core[1] + tail_steps(params))
     tracks = _tracks(job, window, None)
     own = job.own_mmsi or None
     search = find_encounters(tracks, params.encounters, own, counted_steps=core, require_own=False)

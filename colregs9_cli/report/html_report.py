@@ -18,6 +18,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..core.replay_results import EncounterOutcome, ReplayResult
+from ..core.rows import situation_or_interaction
 from .chart_plot import Bounds, draw_chart, geographic_axes, show_view
 from .html_page import cell_text, file_links, page, sortable_table
 
@@ -72,11 +73,11 @@ def _encounter_row(outcome: EncounterOutcome, numbers: Mapping[str, int]) -> lis
         s.trigger_utc,
         _vessel(s.own_name, s.own_mmsi),
         _vessel(s.target_name, s.target_mmsi),
-        cell_text(s.situation),
+        situation_or_interaction(s),
         cell_text(s.own_role_final),
         cell_text(s.target_role_final),
-        "applied" if s.rule9_applied else "not applied",
-        f"rule {cell_text(s.deciding_rule)}",
+        "" if s.rule9_applied is None else "applied" if s.rule9_applied else "not applied",
+        "" if s.deciding_rule is None else f"rule {cell_text(s.deciding_rule)}",
         s.cpa_m,
         s.actual_min_separation_m,
         s.data_covers_cpa,
@@ -220,7 +221,7 @@ def overview_figure(result: ReplayResult, chart: Chart | None) -> Figure:
     for pair, (pair_north, pair_east), text, anchor, offset in zip(
         result.pairs, positions, texts, anchors, offsets, strict=True
     ):
-        situation = cell_text(pair.summary.situation)
+        situation = situation_or_interaction(pair.summary)
         ax.plot(
             pair_east,
             pair_north,
@@ -285,7 +286,8 @@ def replay_html(
         f"<h1>{html.escape(title)}</h1>",
         f"<p>{counts.vessels} vessels; {counts.encounters} encounters, {counts.triggered} "
         f"triggered (CPA &lt; {result.params.encounters.cpa_req_m:g} m within 0 ≤ TCPA ≤ "
-        f"{result.params.encounters.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs. Files: "
+        f"{result.params.encounters.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs; "
+        f"{html.escape(result.interaction_summary)} (only encounters get a verdict). Files: "
         f"{file_links(files)}.</p>",
     ]
     if result.pairs:

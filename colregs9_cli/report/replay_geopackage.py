@@ -124,8 +124,8 @@ def _action_before_cpa_s(summary: EncounterSummary, mmsi: int) -> float:
     """How long before CPA the vessel ``mmsi`` acted, NaN when she is not a give-way vessel
     or did not act (``give_way_vessels`` and ``action_before_cpa_s`` list the give-way
     vessels in the same order)."""
-    give_way = summary.give_way_vessels.split(";")
-    seconds = summary.action_before_cpa_s.split(";")
+    give_way = (summary.give_way_vessels or "").split(";")
+    seconds = (summary.action_before_cpa_s or "").split(";")
     if str(mmsi) not in give_way:
         return float("nan")
     value = seconds[give_way.index(str(mmsi))]

@@ -22,7 +22,13 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..core.replay_results import EncounterOutcome, PairOutcome, ReplayResult
-from ..core.rows import ENCOUNTER_COLUMNS, PAIR_COLUMNS
+from ..core.rows import (
+    ENCOUNTER_COLUMNS,
+    PAIR_COLUMNS,
+    EncounterSummary,
+    PairSummary,
+    situation_or_interaction,
+)
 from ..outputs import report_directory, save_figure, write_csv, write_json, write_text
 from ..timebase import DISPLAY_TIME_FORMAT
 from .chart_plot import (
@@ -76,6 +82,12 @@ def _cell(value: Any) -> Any:
     return value
 
 
+# The navigational status codes of pairs.csv and encounters.csv.
+NAV_STATUS_COLUMNS = frozenset(
+    {"nav_status_a", "nav_status_b", "own_nav_status", "target_nav_status"}
+)
+
+
 def _summary_table(summaries: list[Any], columns: tuple[str, ...]) -> pd.DataFrame:
     records = [
         {name: _cell(value) for name, value in dataclasses.asdict(summary).items()}
@@ -84,7 +96,7 @@ def _summary_table(summaries: list[Any], columns: tuple[str, ...]) -> pd.DataFra
     table = pd.DataFrame.from_records(records, columns=list(columns))
     # Codes, not measurements: 0 not 0.0, empty when the vessel never sent one.
     for name in columns:
-        if "nav_status" in name:
+        if name in NAV_STATUS_COLUMNS:
             table[name] = table[name].astype("Int64")
     return table
 
@@ -142,6 +154,8 @@ def format_summary(result: ReplayResult) -> str:
         f"{counts.candidate_pairs} candidate pairs, {counts.encounters} encounters, "
         f"{counts.triggered} triggered ({counts.triggered_pairs} pairs)."
     ]
+    if result.pairs:
+        lines.append(f"{result.interaction_summary}; only encounters get a verdict.")
     if not result.pairs:
         lines.append(
             "No triggered encounters: no pair came within "
@@ -156,10 +170,10 @@ def format_summary(result: ReplayResult) -> str:
         rows.append(
             [
                 s.pair_id,
-                _cell(s.situation),
+                situation_or_interaction(s),
                 "yes" if s.situation_ambiguous else "",
-                s.give_way_vessels or "none",
-                _cell(s.deciding_rule),
+                _give_way_text(s),
+                "" if s.deciding_rule is None else _cell(s.deciding_rule),
                 _number(s.cpa_m, 1),  # 149.8, not the 150 m threshold
                 _number(s.tcpa_s, 0),
                 _number(s.actual_min_separation_m, 1),
@@ -172,8 +186,20 @@ def format_summary(result: ReplayResult) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _give_way_text(summary: PairSummary | EncounterSummary) -> str:
+    """The final give-way vessels; empty for a pair that is not an encounter."""
+    if summary.situation is None:
+        return ""
+    return summary.give_way_vessels or "none"
+
+
 def _verdict(outcome: EncounterOutcome) -> str:
     s = outcome.summary
+    if s.situation is None:
+        return (
+            f"{s.interaction.value}, not a COLREGs encounter: {s.interaction_basis}"
+            f"\nCPA {s.cpa_m:.0f} m in {s.tcpa_s:.0f} s"
+        )
     rule9 = "rule 9 applied" if s.rule9_applied else "rule 9 not applied"
     ambiguous = ", ambiguous" if s.situation_ambiguous else ""
     return (
@@ -471,7 +497,8 @@ def format_index(result: ReplayResult, plots: bool) -> str:
         f"{counts.vessels} vessels; {counts.encounters} encounters (a pair within range of "
         f"each other, seen from each reported seat), {counts.triggered} of them triggered "
         f"(CPA < {result.params.encounters.cpa_req_m:g} m within 0 <= TCPA <= "
-        f"{result.params.encounters.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs.",
+        f"{result.params.encounters.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs; "
+        f"{result.interaction_summary} (only encounters get a verdict).",
         "",
         f"- [{PAIRS_NAME}]({PAIRS_NAME}): one row per triggered pair, with the pair-level "
         "verdict (the same whichever vessel is own ship).",
@@ -502,9 +529,9 @@ def format_index(result: ReplayResult, plots: bool) -> str:
         acted = "" if s.give_way_vessel_acted is None else _cell(s.give_way_vessel_acted)
         lines.append(
             f"| {s.encounter_id} | {_cell(s.trigger_utc)} | {s.own_mmsi} | {s.target_mmsi} "
-            f"| {_cell(s.situation)} | {'yes' if s.situation_ambiguous else ''} "
-            f"| {_cell(s.own_role_colregs)} | {_cell(s.target_estimated_restricted)} "
-            f"| {s.automaton_path} | {_cell(s.deciding_rule)} | {s.give_way_vessels or 'none'} "
+            f"| {situation_or_interaction(s)} | {'yes' if s.situation_ambiguous else ''} "
+            f"| {_cell(s.own_role_colregs) or ''} | {_cell(s.target_estimated_restricted) or ''} "
+            f"| {s.automaton_path or ''} | {_cell(s.deciding_rule) or ''} | {_give_way_text(s)} "
             f"| {_number(s.cpa_m, 0)} | {_number(s.actual_min_separation_m, 0)} | {acted} "
             f"| {links} |"
         )

@@ -40,6 +40,7 @@ from shapely.ops import polylabel
 from colregs9_cli.charts.water import Chart, load_chart
 from colregs9_cli.core.manoeuvrability import (
     ManoeuvrabilityParams,
+    SwingModel,
     VesselState,
     assess_manoeuvrability,
     target_rate_of_swing_deg_per_m,
@@ -77,7 +78,7 @@ def _interleaved_rates(
 
 
 def _loop_assessment(water: object, north: float, east: float, course: float) -> np.ndarray:
-    params = ManoeuvrabilityParams()
+    params = ManoeuvrabilityParams(swing_model=SwingModel.FIXED)
     rate = params.alpha * target_rate_of_swing_deg_per_m(LENGTH_M, params)
     arcs = turning_arcs(north, east, course, SPEED_MPS, rate, params.horizon_s, params.step_s)
     a_m, b_m = params.domain_length_factor * LENGTH_M, params.domain_breadth_factor * BREADTH_M
@@ -144,7 +145,7 @@ def main() -> None:
     index = chart.water_index(DRAUGHT_M)
     build_s = time.perf_counter() - start
     unprepared = shapely.from_wkb(shapely.to_wkb(index.water))
-    params = ManoeuvrabilityParams()
+    params = ManoeuvrabilityParams(swing_model=SwingModel.FIXED)
     print(f"navigable water for {DRAUGHT_M} m built once in {build_s * 1e3:.0f} ms, then cached")
     print(f"{'':<49} {'assessments/s':>17} {'speed-up':>18}")
     print(f"{'position':<30} {'method':<18} {'best':>8} {'median':>8} {'best':>9} {'median':>8}")
