@@ -5,15 +5,17 @@
     positions = colregs9.read_ais(["aisdk-2024-09-09.csv"])          # canonical DataFrame
     table = colregs9.vessel_stats(["aisdk-2024-09-09.csv"])           # the stats table
     result = colregs9.replay(["day.nmea.gz"], charts=["cell.000"])    # nothing written
-    result.pairs[0].summary                                           # a pair's verdict
+    result.pairs, result.encounters, result.tracks                     # DataFrames
 
-Paths may be strings. Errors are ``colregs9_cli.errors.Colregs9Error`` subclasses with the
-message the command line prints.
+Paths may be strings. Errors are ``Colregs9Error`` (here, and its subclasses) with the
+message the command line prints. Importing this module changes nothing in the process: no
+matplotlib backend, no signal handler (those are the console script's, ``cli.run``).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -21,9 +23,31 @@ import pandas as pd
 from .ais.load import count_ais, load_ais
 from .core.dimensions import GroupBy, Per, dimension_stats
 from .core.replay_results import ReplayResult
-from .errors import ParameterError
+from .errors import (
+    ChartError,
+    Colregs9Error,
+    InputFileError,
+    NoDataError,
+    OutputError,
+    ParameterError,
+    QueryError,
+)
 from .jobs.replay import run_replay
 from .query import everything_query, load_query
+
+__all__ = [
+    "ChartError",
+    "Colregs9Error",
+    "InputFileError",
+    "NoDataError",
+    "OutputError",
+    "ParameterError",
+    "QueryError",
+    "Replay",
+    "read_ais",
+    "replay",
+    "vessel_stats",
+]
 
 PathLike = str | Path
 
@@ -55,18 +79,63 @@ def vessel_stats(
     ).to_frame()
 
 
+@dataclass(frozen=True, eq=False)
+class Replay:
+    """A replay's tables as DataFrames, and the whole result.
+
+    ``pairs`` and ``encounters`` have the columns of pairs.csv and encounters.csv, typed
+    (enums as their text, times as UTC timestamps, nullable integers and booleans);
+    ``tracks`` has both vessels' tracks of every encounter, a row per time step:
+    ``encounter_id``, ``pair_id``, ``vessel`` (``own``/``target``), ``mmsi``,
+    ``timestamp`` (UTC), ``lat_deg``, ``lon_deg``, ``north_m``, ``east_m`` (in the run's
+    frame, ``result.frame``, but for a pair beyond its reach: ``EncounterOutcome``).
+    ``text`` is what the command prints; ``result`` holds the rest (counts, run.json's
+    manifest, each seat's series and figure data).
+    """
+
+    pairs: pd.DataFrame
+    encounters: pd.DataFrame
+    tracks: pd.DataFrame
+    text: str
+    result: ReplayResult
+
+    @classmethod
+    def of(cls, result: ReplayResult) -> Replay:
+        """The tables of a ``ReplayResult`` (of this API, or of ``jobs.replay.run_replay``)."""
+        return cls(
+            pairs=result.pairs_table,
+            encounters=result.encounters_table,
+            tracks=result.tracks_table,
+            text=result.text,
+            result=result,
+        )
+
+    def series(self, encounter_id: str) -> pd.DataFrame:
+        """The time series of one encounter, as its CSV under encounters/ holds it."""
+        for seat in self.result.encounters:
+            if seat.summary.encounter_id == encounter_id:
+                return seat.series
+        raise ParameterError(
+            f"encounter_id {encounter_id!r}: no such encounter; the encounters table's "
+            "encounter_id column lists them"
+        )
+
+
 def replay(
     paths: Sequence[PathLike],
     charts: Sequence[PathLike] = (),
     query: PathLike | None = None,
     own_mmsi: Sequence[int] = (),
-) -> ReplayResult:
-    """The replay of ``colregs9 replay``, in memory: pairs, seats, series, verdicts."""
-    return run_replay(
-        [Path(p) for p in paths],
-        chart_paths=[Path(c) for c in charts],
-        query_path=None if query is None else Path(query),
-        own_mmsi=own_mmsi,
-        plots=False,
-        write=False,
+) -> Replay:
+    """The replay of ``colregs9 replay``, in memory (nothing is written): its pairs,
+    encounters and tracks as DataFrames (``Replay``)."""
+    return Replay.of(
+        run_replay(
+            [Path(p) for p in paths],
+            chart_paths=[Path(c) for c in charts],
+            query_path=None if query is None else Path(query),
+            own_mmsi=own_mmsi,
+            plots=False,
+            write=False,
+        )
     )

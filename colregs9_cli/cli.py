@@ -23,7 +23,10 @@ QUIET_HELP = (
     "No progress bars and no closing line naming the files written, both on stderr "
     "(progress bars are also off when stderr is not a terminal). Results and errors still print."
 )
-OVERWRITE_HELP = "Replace an --out directory that holds something other than a colregs9 report."
+OVERWRITE_HELP = (
+    "Write into an --out that holds a report of another command or files colregs9 did not "
+    "write; only colregs9's files are replaced, yours stay."
+)
 # What every AIS reader takes (ais/sources.py tells the compression from the first bytes).
 AIS_FILES_HELP = (
     "AIS files: DMA CSV (22 or 26 columns), MarineCadastre CSV (2015 on), exactEarth/Spire CSV, "

@@ -3,6 +3,8 @@ number of workers, and clear errors."""
 
 from __future__ import annotations
 
+import operator
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -101,3 +103,61 @@ def test_bad_worker_options_are_one_error(tmp_path: Path, options, message) -> N
     )
     assert result.exit_code == 2, result.output
     assert result.output.startswith(f"Error: {message}")
+
+
+def test_a_local_cluster_leaves_nothing_in_the_temporary_directory(tmp_path: Path) -> None:
+    """``--workers 2`` through the console script, which leaves with ``os._exit``: neither
+    multiprocessing's ``pymp-*`` (the forkserver's socket) nor Dask's worker directories
+    and lock files stay in TMPDIR (issue 30)."""
+    tmp = tmp_path / "t"
+    tmp.mkdir()
+    result = subprocess.run(
+        [
+            *(sys.executable, "-m", "colregs9_cli", "replay", str(NMEA), "--quiet", "--no-plots"),
+            *("--out", str(tmp_path / "r"), "--slab-minutes", "1", "--workers", "2"),
+        ],
+        capture_output=True,
+        text=True,
+        check=False,
+        env={**os.environ, "TMPDIR": str(tmp)},
+    )
+    assert result.returncode == 0, result.stderr
+    assert sorted(p.name for p in tmp.rglob("*")) == []
+    assert (tmp_path / "r" / "pairs.csv").is_file()
+
+
+def test_local_clusters_one_after_another_in_one_process(tmp_path: Path) -> None:
+    """The forkserver a cluster started is stopped with it (its socket was in a directory
+    now removed): the next cluster of the process starts its own, and leaves nothing."""
+    for _ in range(2):
+        with dask_run.dask_client(1, None, tmp_path) as client:
+            assert client.submit(operator.add, 1, 2).result() == 3
+            (made,) = tmp_path.iterdir()
+            assert made.name.startswith("colregs9-dask-")
+        assert list(tmp_path.iterdir()) == []
+
+
+def _write_after(started: Path, path: Path, delay_s: float) -> None:
+    import time
+
+    started.write_text("")
+    time.sleep(delay_s)
+    path.write_text("late")
+
+
+def test_settling_waits_for_the_tasks_that_run(tmp_path: Path) -> None:
+    """After a failure while the workers write into the report's staging directory: a
+    running task cannot be stopped, so ``settle_tasks`` returns only once it has ended
+    (the staging directory is removed after), and a task not begun never runs."""
+    import time
+
+    with dask_run.dask_client(1, None, tmp_path) as client:
+        started = tmp_path / "started"
+        running = client.submit(_write_after, started, tmp_path / "running", 1.0, pure=False)
+        queued = client.submit(_write_after, started, tmp_path / "queued", 0.0, pure=False)
+        while not started.exists():
+            time.sleep(0.01)
+        dask_run.settle_tasks(client, [running, queued])
+        assert (tmp_path / "running").read_text() == "late"
+        time.sleep(0.3)
+        assert not (tmp_path / "queued").exists()

@@ -3,6 +3,7 @@ from the umask, and a bad --out refused with one Error line before any work."""
 
 from __future__ import annotations
 
+import json
 import os
 import stat
 from pathlib import Path
@@ -12,7 +13,7 @@ from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
 from colregs9_cli.errors import OutputError
-from colregs9_cli.outputs import check_out_dir, report_directory, write_text
+from colregs9_cli.outputs import FILES_KEY, check_out_dir, report_directory, write_text
 
 from fixture_files import DMA26, NMEA
 
@@ -70,12 +71,15 @@ def test_a_foreign_directory_is_refused_unless_overwrite(tmp_path: Path) -> None
     (out / "thesis.tex").write_text("precious")
     refused = _invoke("stats", str(DMA26), "--quiet", "--out", str(out))
     assert refused.exit_code == OutputError.exit_code
-    assert "not a colregs9 report" in _one_error_line(refused.output)
+    line = _one_error_line(refused.output)
+    assert "not a colregs9 report and holds 1 item(s): thesis.tex;" in line
     assert (out / "thesis.tex").read_text() == "precious"
-    replaced = _invoke("stats", str(DMA26), "--quiet", "--out", str(out), "--overwrite")
-    assert replaced.exit_code == 0, replaced.output
-    assert not (out / "thesis.tex").exists() and (out / "run.json").is_file()
-    # a colregs9 report is replaced without --overwrite
+    # --overwrite writes the report beside the user's file, which stays
+    beside = _invoke("stats", str(DMA26), "--quiet", "--out", str(out), "--overwrite")
+    assert beside.exit_code == 0, beside.output
+    assert (out / "thesis.tex").read_text() == "precious" and (out / "run.json").is_file()
+    # a colregs9 report is replaced without --overwrite once only its own files are there
+    (out / "thesis.tex").unlink()
     again = _invoke("stats", str(DMA26), "--quiet", "--out", str(out))
     assert again.exit_code == 0, again.output
 
@@ -102,7 +106,7 @@ def test_an_unwritable_parent_is_refused(tmp_path: Path) -> None:
     locked.chmod(0o500)
     try:
         with pytest.raises(OutputError, match="no permission"):
-            check_out_dir(locked / "report")
+            check_out_dir(locked / "report", command="replay")
     finally:
         locked.chmod(0o700)
 
@@ -168,9 +172,10 @@ def test_swing_and_demo_refuse_a_foreign_directory_unless_overwrite(tmp_path: Pa
     assert "not a colregs9 report" in _one_error_line(refused.output)
     assert [p.name for p in out.iterdir()] == ["thesis.tex"]
     assert [p.name for p in tmp_path.iterdir()] == ["mine"]  # no staging left either
-    replaced = run(out, "--overwrite")
-    assert replaced.exit_code == 0, replaced.output
-    assert not (out / "thesis.tex").exists() and (out / "run.json").is_file()
+    beside = run(out, "--overwrite")
+    assert beside.exit_code == 0, beside.output
+    assert (out / "thesis.tex").read_text() == "precious" and (out / "run.json").is_file()
+    assert "thesis.tex" not in json.loads((out / "run.json").read_text())[FILES_KEY]
 
 
 @pytest.mark.parametrize("run", [_swing, _demo], ids=["swing", "demo"])
@@ -179,9 +184,15 @@ def test_swing_and_demo_rerun_into_a_fresh_directory(tmp_path: Path, run) -> Non
     first = run(out)
     assert first.exit_code == 0, first.output
     written = sorted(p.relative_to(out) for p in out.rglob("*"))
-    (out / "stale.png").write_text("an earlier run's figure")
-    for scenario_report in (p for p in out.iterdir() if p.is_dir()):  # the demo's replays
-        (scenario_report / "stale.csv").write_text("an earlier run's encounter")
+    listed = json.loads((out / "run.json").read_text())[FILES_KEY]
+    assert listed == sorted(str(p) for p in written if (out / p).is_file())
+    # Files of an earlier run, which its run.json lists (the demo's replays too).
+    stale = ["stale.png", *(f"{p.name}/stale.csv" for p in out.iterdir() if p.is_dir())]
+    for name in stale:
+        (out / name).write_text("an earlier run's file")
+    (out / "run.json").write_text(
+        json.dumps({**json.loads((out / "run.json").read_text()), FILES_KEY: listed + stale})
+    )
     again = run(out)  # a colregs9 report: replaced without --overwrite
     assert again.exit_code == 0, again.output
     assert sorted(p.relative_to(out) for p in out.rglob("*")) == written
@@ -189,8 +200,6 @@ def test_swing_and_demo_rerun_into_a_fresh_directory(tmp_path: Path, run) -> Non
 
 
 def test_the_demo_names_its_files_where_they_are_after_the_swap(tmp_path: Path) -> None:
-    import json
-
     out = tmp_path / "demo"
     result = _demo(out)
     assert result.exit_code == 0, result.output
@@ -200,6 +209,8 @@ def test_the_demo_names_its_files_where_they_are_after_the_swap(tmp_path: Path) 
         manifest = json.loads((out / scenario / "run.json").read_text())
         (ais,) = manifest["inputs"]
         assert Path(ais["path"]) == out / f"simulate-{scenario}.csv"
+        # each replay still lists its own files, relative to its directory
+        assert "pairs.csv" in manifest[FILES_KEY] and "run.json" in manifest[FILES_KEY]
     assert json.loads((out / "run.json").read_text())["command"] == "demo"
 
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pyarrow as pa
 
-from .schema import CANONICAL_SCHEMA
+from .schema import ANTENNA_OFFSETS, CANONICAL_SCHEMA
 
 STATIC_SCHEMA = pa.schema(
     [
@@ -24,6 +24,7 @@ STATIC_SCHEMA = pa.schema(
             "ship_type",
             "length_m",
             "breadth_m",
+            *ANTENNA_OFFSETS,
             "draught_m",
             "name",
             "callsign",

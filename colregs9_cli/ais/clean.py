@@ -4,8 +4,8 @@
 (181), SOG 102.3 and above, COG 360 and above, heading 360 and above (511), a rate of turn
 beyond ±720 deg/min (the sentinel -128 decoded), dimension 0 or less, draught 0 or less, a
 dimension beyond what ships have or not finite (``MAX_LENGTH_M`` ...; counted as
-``implausible_dimension``), IMO 0 or less, and the texts ``Unknown``, ``Undefined``,
-``Unknown value`` and empty text in text columns.
+``implausible_dimension``), AIS's A, B, C, D as ``offset_parts`` says, IMO 0 or less, and
+the texts ``Unknown``, ``Undefined``, ``Unknown value`` and empty text in text columns.
 """
 
 from __future__ import annotations
@@ -28,6 +28,7 @@ from ..vessels import (
     MMSI_MIN,
     VESSEL_MOBILE_TYPES,
 )
+from .schema import ANTENNA_OFFSETS
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -210,13 +211,6 @@ def clean_rot(values: FloatArray) -> FloatArray:
     return cleaned + 0.0  # turns -0.0 into 0.0
 
 
-def dimension(first: FloatArray, second: FloatArray, total: FloatArray) -> FloatArray:
-    """Length as A+B (or breadth as C+D) when both are > 0, else the total column if > 0."""
-    with np.errstate(invalid="ignore"):
-        both = (first > 0) & (second > 0)
-    return np.where(both, first + second, positive_or_nan(total))
-
-
 def clean_text(values: pa.Array | pa.ChunkedArray) -> pa.Array:
     """Trimmed text with the "not available" spellings (``Unknown``, empty, ...) as null."""
     if isinstance(values, pa.ChunkedArray):
@@ -325,6 +319,92 @@ class DimensionColumns:
     def implausible_rows(self, rows: NDArray[np.int64]) -> BoolArray:
         """``implausible`` for some rows of ``self.table`` (indices)."""
         return self.implausible(self.table.take(pa.array(rows, pa.int64())))
+
+
+@dataclass(frozen=True)
+class OffsetParts:
+    """Each row's AIS A, B, C, D cleaned by ``offset_parts`` (NaN: not available), and the
+    length and breadth they give (NaN where they give none), before the module limits."""
+
+    to_bow_m: FloatArray
+    to_stern_m: FloatArray
+    to_port_m: FloatArray
+    to_starboard_m: FloatArray
+    length_m: FloatArray
+    breadth_m: FloatArray
+
+    def dimensions(
+        self, length_m: FloatArray, breadth_m: FloatArray, draught_m: FloatArray
+    ) -> Dimensions:
+        """A reader's measure (``DimensionColumns``): length and breadth from the parts
+        where they give them, else from the length and breadth columns where > 0; the
+        draught where > 0. Before the module limits."""
+        return (
+            np.where(np.isnan(self.length_m), positive_or_nan(length_m), self.length_m),
+            np.where(np.isnan(self.breadth_m), positive_or_nan(breadth_m), self.breadth_m),
+            positive_or_nan(draught_m),
+        )
+
+    def trusted(self, measured: Dimensions) -> list[FloatArray]:
+        """A, B, C, D, all four NaN on the rows whose length or breadth in ``measured``
+        (``dimensions``) ``plausible`` drops: a corrupt row's parts are not trusted either,
+        and the row is counted once, as ``implausible_dimension``, with its length or
+        breadth."""
+        with np.errstate(invalid="ignore"):
+            dropped = (measured[0] > 0.0) & ~(measured[0] <= MAX_LENGTH_M)
+            dropped |= (measured[1] > 0.0) & ~(measured[1] <= MAX_BREADTH_M)
+        parts = [self.to_bow_m, self.to_stern_m, self.to_port_m, self.to_starboard_m]
+        if not dropped.any():
+            return parts
+        return [np.where(dropped, np.nan, part) for part in parts]
+
+    def columns(self, measured: Dimensions) -> dict[str, pa.Array]:
+        """``trusted`` as the four canonical columns (``schema.ANTENNA_OFFSETS``)."""
+        return {
+            name: nan_to_null(part)
+            for name, part in zip(ANTENNA_OFFSETS, self.trusted(measured), strict=True)
+        }
+
+
+def offset_parts(a: FloatArray, b: FloatArray, c: FloatArray, d: FloatArray) -> OffsetParts:
+    """AIS A (to the bow), B (to the stern), C (to port), D (to starboard) as read, in
+    metres, cleaned the one way every reader cleans them (ITU-R M.1371, "reference point
+    for reported position"):
+
+    - a part of 0 or less, or NaN, is not available (0 is AIS's "not available");
+    - A = C = 0 with B, D > 0 is "reference point not available, dimensions available":
+      no part is available, and the vessel is B long and D wide;
+    - length is A + B where both are given, breadth C + D. A part given alone (its
+      partner not available) gives no length, unless it alone is beyond what ships have
+      (``MAX_LENGTH_M``, ``MAX_BREADTH_M``) or not finite: it is then the length (or
+      breadth), which the limits drop as implausible and the ledger counts, rather than
+      a corrupt part kept silently.
+    """
+    with np.errstate(invalid="ignore"):
+        no_reference = (a == 0.0) & (c == 0.0) & (b > 0.0) & (d > 0.0)
+        bow, stern, port, starboard = (
+            np.where(no_reference, np.nan, positive_or_nan(part)) for part in (a, b, c, d)
+        )
+        length_m = np.where(no_reference, b, _span(bow, stern, MAX_LENGTH_M))
+        breadth_m = np.where(no_reference, d, _span(port, starboard, MAX_BREADTH_M))
+    return OffsetParts(bow, stern, port, starboard, length_m, breadth_m)
+
+
+def _span(first: FloatArray, second: FloatArray, limit_m: float) -> FloatArray:
+    """first + second where both are given (> 0); a lone part beyond ``limit_m`` (or
+    infinite) as itself; else NaN. The parts are positive or NaN."""
+    with np.errstate(invalid="ignore"):
+        lone = np.where(np.isnan(first), second, first)
+        return np.where(
+            ~np.isnan(first) & ~np.isnan(second),
+            first + second,
+            np.where(lone > limit_m, lone, np.nan),
+        )
+
+
+def no_offsets(rows: int) -> dict[str, pa.Array]:
+    """The four canonical offset columns, all null: a layout without A, B, C, D."""
+    return dict.fromkeys(ANTENNA_OFFSETS, pa.nulls(rows, pa.float64()))
 
 
 def any_dimension(length_m: FloatArray, breadth_m: FloatArray, draught_m: FloatArray) -> BoolArray:

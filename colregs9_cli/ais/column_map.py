@@ -21,9 +21,10 @@ from their entries in layouts.py); any other CSV is read with a map from a TOML 
     draught_m = [0, 25.5]           # values (as written, before units) meaning not available
 
 Targets besides the canonical columns: ``to_bow``, ``to_stern``, ``to_port``,
-``to_starboard`` (the AIS A, B, C, D), ``message_type`` (the AIS message number, which tells
-the mobile type: 1-3, 5, 27 Class A; 18, 19, 24 Class B; 4, 9, 11, 21 not a vessel; other
-types are ``unsupported_message_type``) and ``millisecond`` (added to the time). Values:
+``to_starboard`` (the AIS A, B, C, D, which fill ``to_bow_m`` ... ``to_starboard_m``),
+``message_type`` (the AIS message number, which tells the mobile type: 1-3, 5, 27 Class A;
+18, 19, 24 Class B; 4, 9, 11, 21 not a vessel; other types are ``unsupported_message_type``)
+and ``millisecond`` (added to the time). Values:
 ``ship_type`` and ``nav_status`` may be ITU codes or text; ``mobile_type`` ``A``/``B`` or
 ``Class A``/``Class B`` (other text: not a vessel). A map with neither ``mobile_type`` nor
 ``message_type`` reads every row as a vessel of unknown class (``mobile_type`` null): such
@@ -44,12 +45,14 @@ from typing import Any
 
 from ..errors import ParameterError
 from .layouts import LAYOUTS, MAP_PREFIX, Layout
-from .schema import CANONICAL_COLUMNS
+from .schema import ANTENNA_OFFSETS, CANONICAL_COLUMNS
 
 TIME_UNIX = "unix"
 TIME_UNIX_MS = "unix_ms"
 
-CANONICAL_TARGETS = CANONICAL_COLUMNS
+# A map names AIS's A, B, C, D ``to_bow`` ... (``PART_TARGETS``), as written before the
+# canonical schema had them; they fill ``to_bow_m`` ... (``schema.ANTENNA_OFFSETS``).
+CANONICAL_TARGETS = tuple(c for c in CANONICAL_COLUMNS if c not in ANTENNA_OFFSETS)
 PART_TARGETS = ("to_bow", "to_stern", "to_port", "to_starboard")
 EXTRA_TARGETS = (*PART_TARGETS, "message_type", "millisecond")
 TARGETS = (*CANONICAL_TARGETS, *EXTRA_TARGETS)

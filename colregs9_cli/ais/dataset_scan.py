@@ -5,9 +5,16 @@ in the canonical schema under hive partitions ``date=YYYY-MM-DD/`` (``date=__HIV
 PARTITION__/`` for static reports whose time does not parse). See ``dataset.py`` for how it
 is written. Opening one (``Dataset.open``) checks it whole against its manifest, from the
 manifest and the files' footers only: every listed file is there with the canonical schema
-and the row count listed, and no other Parquet file lies in it. The scans are
-``pyarrow.dataset`` scans with the query pushed down: the time window prunes partitions and,
-with the region, row groups by their statistics; only the columns asked for are decoded.
+(of its input's format version) and the row count listed, and no other Parquet file lies in
+it. The scans are ``pyarrow.dataset`` scans with the query pushed down: the time window
+prunes partitions and, with the region, row groups by their statistics; only the columns
+asked for are decoded.
+
+Format versions: 2 has the canonical schema with AIS's A, B, C, D (``to_bow_m`` ...); 1, from
+before, lacks those four columns. A version 1 dataset, or a version 2 one holding inputs
+ingested as version 1 (an ingest into a version 1 dataset upgrades its manifest), is read
+with the four null for those inputs' rows: the scans fill a column a file lacks with nulls.
+Re-ingesting its inputs gives them their A, B, C, D.
 
 Used by ``load.load_ais`` (so a dataset is accepted wherever AIS files are) and by
 ``dataset.py``; it imports neither.
@@ -30,11 +37,16 @@ from ..errors import InputFileError
 from ..query import Query, ms_at_or_after
 from .ledger import RejectsLedger
 from .query_rows import rows_in_query
-from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
+from .schema import ANTENNA_OFFSETS, CANONICAL_COLUMNS, CANONICAL_SCHEMA
 
 MANIFEST_NAME = "colregs9-dataset.json"
 DATASET_FORMAT = "colregs9-dataset"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+# The schema of the files of each format version: 1 had no A, B, C, D.
+FILE_SCHEMAS: dict[int, pa.Schema] = {
+    1: pa.schema([f for f in CANONICAL_SCHEMA if f.name not in ANTENNA_OFFSETS]),
+    FORMAT_VERSION: CANONICAL_SCHEMA,
+}
 PARTITION_FIELD = pa.field("date", pa.date32())
 # The hive convention for a null partition value (Spark, DuckDB and polars read it so too).
 UNDATED = "__HIVE_DEFAULT_PARTITION__"
@@ -54,9 +66,10 @@ def is_dataset(path: Path) -> bool:
     return Path(path).is_dir() and (Path(path) / MANIFEST_NAME).is_file()
 
 
-def manifest_schema() -> list[dict[str, str]]:
-    """The canonical schema as the manifest records it."""
-    return [{"name": f.name, "type": str(f.type)} for f in CANONICAL_SCHEMA]
+def manifest_schema(version: int = FORMAT_VERSION) -> list[dict[str, str]]:
+    """The files' schema of a format version (default: this colregs9's, the canonical schema)
+    as the manifest records it."""
+    return [{"name": f.name, "type": str(f.type)} for f in FILE_SCHEMAS[version]]
 
 
 def utc_ms(moment: datetime) -> int:
@@ -81,7 +94,8 @@ class DatasetFile:
 
 @dataclass(frozen=True)
 class DatasetInput:
-    """One ingested input as the manifest records it (``entry``: the whole record)."""
+    """One ingested input as the manifest records it (``entry``: the whole record, with its
+    ``format_version``, which a version 1 manifest leaves out)."""
 
     path: str
     sha256: str
@@ -90,6 +104,7 @@ class DatasetInput:
     ledger: RejectsLedger
     files: tuple[DatasetFile, ...]
     entry: dict[str, Any]
+    format_version: int = FORMAT_VERSION
 
 
 def read_manifest(directory: Path) -> list[DatasetInput]:
@@ -115,14 +130,16 @@ def read_manifest(directory: Path) -> list[DatasetInput]:
         ) from None
     if not isinstance(manifest, dict) or manifest.get("format") != DATASET_FORMAT:
         raise InputFileError(f"{path}: not a colregs9 dataset manifest; {_REMEDY}")
-    if manifest.get("format_version") != FORMAT_VERSION:
+    version = manifest.get("format_version")
+    if version not in FILE_SCHEMAS:
         raise InputFileError(
-            f"{path}: dataset format version {manifest.get('format_version')!r}, this colregs9 "
-            f"reads version {FORMAT_VERSION}; use the colregs9 that wrote it, or {_REMEDY}"
+            f"{path}: dataset format version {version!r}, this colregs9 reads versions "
+            f"{', '.join(map(str, FILE_SCHEMAS))}; use the colregs9 that wrote it, or {_REMEDY}"
         )
-    if manifest.get("schema") != manifest_schema():
+    if manifest.get("schema") != manifest_schema(version):
         raise InputFileError(
-            f"{path}: the manifest's schema is not the canonical schema of this colregs9; {_REMEDY}"
+            f"{path}: the manifest's schema is not the canonical schema of format version "
+            f"{version}; {_REMEDY}"
         )
     entries = manifest.get("inputs")
     if not isinstance(entries, list):
@@ -130,7 +147,7 @@ def read_manifest(directory: Path) -> list[DatasetInput]:
     inputs = []
     for number, entry in enumerate(entries, start=1):
         try:
-            inputs.append(_input(entry))
+            inputs.append(_input(entry, version))
         except (KeyError, TypeError, ValueError, AttributeError) as exc:
             raise InputFileError(
                 f"{path}: input {number} of the manifest is malformed ({exc!r}); {_REMEDY}"
@@ -138,7 +155,12 @@ def read_manifest(directory: Path) -> list[DatasetInput]:
     return inputs
 
 
-def _input(entry: dict[str, Any]) -> DatasetInput:
+def _input(entry: dict[str, Any], manifest_version: int) -> DatasetInput:
+    if manifest_version == 1:  # its inputs are all of version 1, which wrote no such key
+        entry = {**entry, "format_version": 1}
+    version = entry["format_version"]
+    if version not in FILE_SCHEMAS or version > manifest_version:
+        raise ValueError(f"format_version {version!r} is not a version of its manifest's")
     files = tuple(
         DatasetFile(str(f["path"]), None if f["date"] is None else str(f["date"]), int(f["rows"]))
         for f in entry["files"]
@@ -160,6 +182,7 @@ def _input(entry: dict[str, Any]) -> DatasetInput:
         ledger=ledger,
         files=files,
         entry=entry,
+        format_version=version,
     )
 
 
@@ -181,6 +204,7 @@ class Dataset:
         directory = Path(directory)
         inputs = tuple(read_manifest(directory))
         listed = [f for item in inputs for f in item.files]
+        versions = [item.format_version for item in inputs for _ in item.files]
         names = {f.path for f in listed}
         for found in sorted(directory.rglob("*.parquet")):
             relative = found.relative_to(directory)
@@ -213,8 +237,10 @@ class Dataset:
                 f"{directory}: cannot open the dataset ({exc}); {_REMEDY}"
             ) from None
         static_rows = sum(
-            _check_fragment(fragment, listed_file, directory / listed_file.path)
-            for fragment, listed_file in zip(arrow.get_fragments(), listed, strict=True)
+            _check_fragment(fragment, listed_file, directory / listed_file.path, version)
+            for fragment, listed_file, version in zip(
+                arrow.get_fragments(), listed, versions, strict=True
+            )
         )
         return cls(directory, inputs, arrow, static_rows)
 
@@ -300,31 +326,38 @@ def _hidden(relative: Path) -> bool:
     return any(part.startswith((".", "_")) for part in relative.parts)
 
 
-def _check_fragment(fragment: ds.ParquetFileFragment, listed: DatasetFile, path: Path) -> int:
-    """Read the file's footer (kept for the scans), check it against the manifest and
-    the canonical schema, and give its number of static rows (null latitudes)."""
+def _check_fragment(
+    fragment: ds.ParquetFileFragment, listed: DatasetFile, path: Path, version: int
+) -> int:
+    """Read the file's footer (kept for the scans), check it against the manifest and the
+    schema of its input's format ``version`` (``FILE_SCHEMAS``), and give its number of
+    static rows (null latitudes)."""
     try:
         fragment.ensure_complete_metadata()
         schema = fragment.physical_schema
         metadata = fragment.metadata
     except (pa.ArrowException, OSError) as exc:
         raise InputFileError(f"{path}: not a readable Parquet file ({exc}); {_REMEDY}") from None
-    for expected in CANONICAL_SCHEMA:
+    expected_schema = FILE_SCHEMAS[version]
+    named = "the canonical schema"
+    if version != FORMAT_VERSION:
+        named = f"the schema of format version {version}"
+    for expected in expected_schema:
         if expected.name not in schema.names:
             raise InputFileError(
-                f"{path}: lacks the canonical column {expected.name!r}; not a file of this "
+                f"{path}: lacks the column {expected.name!r} of {named}; not a file of this "
                 f"dataset: move it out, or {_REMEDY}"
             )
         found = schema.field(expected.name).type
         if found != expected.type:
             raise InputFileError(
-                f"{path}: column {expected.name!r} is {found}, the canonical schema has "
+                f"{path}: column {expected.name!r} is {found}, {named} has "
                 f"{expected.type}; not a file of this dataset: move it out, or {_REMEDY}"
             )
-    if len(schema) != len(CANONICAL_SCHEMA):
-        extra = next(name for name in schema.names if name not in CANONICAL_SCHEMA.names)
+    if len(schema) != len(expected_schema):
+        extra = next(name for name in schema.names if name not in expected_schema.names)
         raise InputFileError(
-            f"{path}: has the column {extra!r}, which the canonical schema has not; not a "
+            f"{path}: has the column {extra!r}, which {named} has not; not a "
             f"file of this dataset: move it out, or {_REMEDY}"
         )
     if metadata.num_rows != listed.rows:

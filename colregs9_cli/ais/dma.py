@@ -4,8 +4,11 @@ older 22-column one, read block by block.
 Column meanings: ``Timestamp`` is ``dd/mm/yyyy HH:MM:SS`` UTC; ``Navigational status`` is
 text (mapped to ITU codes by ``clean.nav_status_code``); ``Ship type`` is DMA's category
 text, kept as it is except ``Undefined`` (null); ``Type of mobile`` is the mobile type
-(``Class A``, ``Class B``, ``Base Station``, ``AtoN``, ...). Length is A+B and breadth C+D
-when both parts are > 0, otherwise the ``Length`` and ``Width`` columns.
+(``Class A``, ``Class B``, ``Base Station``, ``AtoN``, ...). ``A``, ``B``, ``C``, ``D`` (the
+antenna's distances to the bow, stern, port and starboard) become the canonical
+``to_bow_m`` ... ``to_starboard_m`` as ``clean.offset_parts`` cleans them; length is A+B and
+breadth C+D where they give them (B and D where A = C = 0), otherwise the ``Length`` and
+``Width`` columns. The 22-column layout has no A, B, C, D: its parts are null.
 
 A row without a position that carries static fields (a dimension, draught, ship type,
 name, call sign or IMO) is a static report.
@@ -22,19 +25,21 @@ from .clean import (
     DimensionColumns,
     Dimensions,
     Fields,
+    OffsetParts,
     clean_angle,
     clean_rot,
     clean_ship_type,
     clean_sog,
     clean_text,
-    dimension,
     float_column,
     is_vessel,
     mmsi_column,
     nan_to_null,
     nav_status_from_text,
+    no_offsets,
     null_outside,
     number_problems,
+    offset_parts,
     on_the_written_day,
     plausible,
     positive_or_nan,
@@ -52,16 +57,28 @@ def _dimension_columns(has_abcd: bool) -> tuple[str, ...]:
     return (*dimensions, *DMA_ABCD) if has_abcd else dimensions
 
 
-def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
-    """Length and breadth from A+B and C+D where both are given, else from Length and Width
-    (before the plausibility limits, which ``DimensionColumns.clean`` applies)."""
+def _offsets(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> OffsetParts | None:
+    """A, B, C, D cleaned (``clean.offset_parts``); None for the 22-column layout."""
+    if not has_abcd:
+        return None
+    a, b, c, d = (float_column(batch.column(k))[0] for k in DMA_ABCD)
+    return offset_parts(a, b, c, d)
+
+
+def _measure(batch: pa.RecordBatch | pa.Table, offsets: OffsetParts | None) -> Dimensions:
+    """Length and breadth from A, B, C, D where they give them (``offset_parts``), else from
+    Length and Width (before the plausibility limits, which ``DimensionColumns.clean``
+    applies)."""
     width, _ = float_column(batch.column("width"))
     length, _ = float_column(batch.column("length"))
     draught, _ = float_column(batch.column("draught"))
-    if has_abcd:
-        a, b, c, d = (float_column(batch.column(k))[0] for k in DMA_ABCD)
-        return dimension(a, b, length), dimension(c, d, width), positive_or_nan(draught)
-    return positive_or_nan(length), positive_or_nan(width), positive_or_nan(draught)
+    if offsets is None:
+        return positive_or_nan(length), positive_or_nan(width), positive_or_nan(draught)
+    return offsets.dimensions(length, width, draught)
+
+
+def _dimensions(batch: pa.RecordBatch | pa.Table, has_abcd: bool) -> Dimensions:
+    return _measure(batch, _offsets(batch, has_abcd))
 
 
 def dma_fields(batch: pa.RecordBatch, has_abcd: bool) -> Fields:
@@ -107,7 +124,10 @@ def dma_canonical(batch: pa.RecordBatch, has_abcd: bool) -> tuple[pa.Table, Bool
     mmsi, _ = mmsi_column(batch.column("mmsi"))
     lat, _ = float_column(batch.column("latitude"))
     lon, _ = float_column(batch.column("longitude"))
-    length, breadth, draught = plausible(_dimensions(batch, has_abcd))
+    offsets = _offsets(batch, has_abcd)
+    measured = _measure(batch, offsets)
+    length, breadth, draught = plausible(measured)
+    parts = no_offsets(batch.num_rows) if offsets is None else offsets.columns(measured)
     imo, _ = float_column(clean_text(batch.column("imo")))
     table = pa.table(
         {
@@ -124,6 +144,7 @@ def dma_canonical(batch: pa.RecordBatch, has_abcd: bool) -> tuple[pa.Table, Bool
             "mobile_type": clean_text(batch.column("type of mobile")),
             "length_m": nan_to_null(length),
             "breadth_m": nan_to_null(breadth),
+            **parts,
             "draught_m": nan_to_null(draught),
             "name": clean_text(batch.column("name")),
             "callsign": clean_text(batch.column("callsign")),

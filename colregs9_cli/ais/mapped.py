@@ -13,8 +13,11 @@ by block as DMA's (see load.py): ``mapped_fields`` converts the columns every ro
 - mobile type: ``A``/``B``/``Class A``/``Class B`` become ``Class A``/``Class B``; an AIS message
   number gives it (1-3, 5, 27 Class A; 18, 19, 24 Class B; 4, 11 base station, 9 SAR
   aircraft, 21 AtoN: not vessels); with neither column every row is a vessel of unknown class;
-- length and breadth: A+B and C+D where both parts are > 0, else the length and breadth
-  columns; ``IMO9307839`` is read as 9307839; the AIS sentinels become null as in clean.py.
+- A, B, C, D (``to_bow`` ... ``to_starboard``, exactEarth's ``dimension_to_*``): the canonical
+  ``to_bow_m`` ... ``to_starboard_m`` as ``clean.offset_parts`` cleans them (null for a map
+  without them, MarineCadastre's); length and breadth: A+B and C+D where they give them (B
+  and D where A = C = 0), else the length and breadth columns; ``IMO9307839`` is read as
+  9307839; the AIS sentinels become null as in clean.py.
 """
 
 from __future__ import annotations
@@ -32,19 +35,21 @@ from .clean import (
     Dimensions,
     Fields,
     FloatArray,
+    OffsetParts,
     clean_angle,
     clean_rot,
     clean_ship_type,
     clean_sog,
     clean_text,
-    dimension,
     float_column,
     is_vessel,
     mmsi_column,
     nan_to_null,
     nav_status_code,
+    no_offsets,
     null_outside,
     number_problems,
+    offset_parts,
     on_a_real_day,
     on_the_written_day,
     plausible,
@@ -110,13 +115,27 @@ def _number(map_: ColumnMap, batch: Batch, target: str) -> tuple[FloatArray, Boo
     return (numbers * factor if factor != 1.0 else numbers), bad
 
 
-def _dimensions(map_: ColumnMap, batch: Batch) -> Dimensions:
-    """The dimensions as the map makes them, before the plausibility limits."""
+def _offsets(map_: ColumnMap, batch: Batch) -> OffsetParts | None:
+    """A, B, C, D in metres, cleaned (``clean.offset_parts``); None for a map without any."""
+    if not any(map_.has(target) for target in PART_TARGETS):
+        return None
+    a, b, c, d = (_number(map_, batch, target)[0] for target in PART_TARGETS)
+    return offset_parts(a, b, c, d)
+
+
+def _measure(map_: ColumnMap, batch: Batch, offsets: OffsetParts | None) -> Dimensions:
+    """The dimensions as the map makes them, before the plausibility limits: length and
+    breadth from A, B, C, D where they give them, else the length and breadth columns."""
     length, _ = _number(map_, batch, "length_m")
     breadth, _ = _number(map_, batch, "breadth_m")
     draught, _ = _number(map_, batch, "draught_m")
-    a, b, c, d = (_number(map_, batch, t)[0] for t in PART_TARGETS)
-    return dimension(a, b, length), dimension(c, d, breadth), positive_or_nan(draught)
+    if offsets is None:
+        return positive_or_nan(length), positive_or_nan(breadth), positive_or_nan(draught)
+    return offsets.dimensions(length, breadth, draught)
+
+
+def _dimensions(map_: ColumnMap, batch: Batch) -> Dimensions:
+    return _measure(map_, batch, _offsets(map_, batch))
 
 
 def _message_types(map_: ColumnMap, batch: Batch) -> FloatArray:
@@ -309,7 +328,10 @@ def mapped_canonical(map_: ColumnMap, batch: Batch) -> tuple[pa.Table, BoolArray
     lon, _ = _number(map_, batch, "lon_deg")
     imo_text = pc.utf8_ltrim(pc.utf8_upper(_text(map_, batch, "imo")), characters="IMO ")
     imo, _ = float_column(imo_text)
-    length, breadth, draught = plausible(_dimensions(map_, batch))
+    offsets = _offsets(map_, batch)
+    measured = _measure(map_, batch, offsets)
+    length, breadth, draught = plausible(measured)
+    parts = no_offsets(batch.num_rows) if offsets is None else offsets.columns(measured)
     table = pa.table(
         {
             "timestamp": stamps,
@@ -325,6 +347,7 @@ def mapped_canonical(map_: ColumnMap, batch: Batch) -> tuple[pa.Table, BoolArray
             "mobile_type": mobile_types(map_, batch),
             "length_m": nan_to_null(length),
             "breadth_m": nan_to_null(breadth),
+            **parts,
             "draught_m": nan_to_null(draught),
             "name": _text(map_, batch, "name"),
             "callsign": _text(map_, batch, "callsign"),

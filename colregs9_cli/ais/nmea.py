@@ -44,23 +44,27 @@ and are not rows; any other non-blank line is an unparseable row. Invalid MMSIs 
 positions are left to the pipeline, which counts them.
 
 Static join. Positions get ship type, dimensions, draught, name, call sign and IMO from the
-static reports of the same MMSI (types 5, 24 and the static part of 19), field by field, from
-the report nearest in time that has that field. Nearest rather than latest: over a long log
-the draught changes between voyages, and the nearest report is the one that was in force; a
-per-field choice because type 24 part A carries only the name and part B only the rest, so
-the nearest whole report would often have the field empty. A position's own values (type 19)
-win over joined ones. The join needs every static, which may come after the position, so the
-whole input is collected and yielded as one batch: fine for logs of a few million lines (peak
-about 1 kB per message while decoding, measured on the DMA fixture), not for months of raw
-feed — split those by day.
+static reports of the same MMSI (types 5, 24 and the static part of 19), field by field,
+from the report nearest in time that has that field. Nearest rather than latest: over a long
+log the draught changes between voyages, and the nearest report is the one that was in
+force; a per-field choice because type 24 part A carries only the name and part B only the
+rest, so the nearest whole report would often have the field empty. The antenna offsets A,
+B, C, D (``to_bow_m`` ...) are the exception: all four come from the nearest report with any
+of them, never A from one message and B from another. A position's own values (type 19) win
+over joined ones. The tables and the join are built in nmea_tables.py. The join needs every
+static, which may come after the position, so the whole input is collected and yielded as
+one batch: fine for logs of a few million lines (peak about 1 kB per message while decoding,
+measured on the DMA fixture), not for months of raw feed — split those by day.
 
 Not available -> null: lat outside ±90 (91), lon outside ±180 (181), SOG 102.3 (type 27: 63),
 COG and heading 360 and above (360, 511; type 27: 511), rate of turn -128 and ±127 (turning
 fast with no turn indicator: no rate is known), dimension 0, draught 0, ship type 0, IMO 0,
 empty text. The rate of turn is (raw / 4.733)² deg/min with the sign of raw. Type 27 (the
-long-range broadcast of SOLAS ships) is "Class A". A length (A+B) or breadth (C+D) beyond
-what ships have (``vessels.MAX_LENGTH_M``, ``MAX_BREADTH_M``) is dropped too, and its message
-(with a valid MMSI) counted in the ledger as ``implausible_dimension`` (AIS cannot encode a
+long-range broadcast of SOLAS ships) is "Class A". A, B, C, D are cleaned by
+``clean.offset_parts`` (A = C = 0 with B, D > 0: no reference point, the vessel B long and D
+wide). A length (A+B) or breadth (C+D) beyond what ships have (``vessels.MAX_LENGTH_M``,
+``MAX_BREADTH_M``) is dropped too, with the message's four offsets, and the message (with a
+valid MMSI) counted once in the ledger as ``implausible_dimension`` (AIS cannot encode a
 draught beyond ``MAX_DRAUGHT_M``).
 """
 
@@ -68,13 +72,10 @@ from __future__ import annotations
 
 import re
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import cast
 
-import numpy as np
-import pandas as pd
-import pyarrow as pa
 from pyais.exceptions import AISBaseException
 from pyais.messages import (
     AISSentence,
@@ -91,25 +92,13 @@ from pyais.messages import (
     TagBlock,
 )
 
-from ..vessels import MAX_BREADTH_M, MAX_LENGTH_M
-from .batch import STATIC_SCHEMA, AisBatch
-from .clean import (
-    SHIP_TYPE_CATEGORIES,
-    implausible,
-    implausible_text,
-    null_outside,
-    valid_mmsi,
-)
-from .ledger import DropReason, RejectReason, RejectsLedger
-from .schema import CANONICAL_SCHEMA
+from .batch import AisBatch
+from .ledger import RejectReason, RejectsLedger
+from .nmea_tables import NO_TIME_MS, POSITION_TYPES, NmeaColumns, nmea_batch
 from .time_sources import DEFAULT_TIME_SOURCES, TimeSource
 
-POSITION_TYPES = frozenset({1, 2, 3, 18, 19, 27})
 STATIC_TYPES = frozenset({5, 24})
 NOT_A_VESSEL_TYPES = frozenset({4, 9, 11, 21})  # base station, SAR aircraft, UTC reply, AtoN
-_CLASS_B_TYPES = frozenset({18, 19})
-# Type 27 is the long-range broadcast of SOLAS (Class A) ships.
-_MOBILE_TYPE = {t: "Class B" if t in _CLASS_B_TYPES else "Class A" for t in POSITION_TYPES}
 
 _EXAMPLE_CHARS = 160
 _MAX_UNIX_S = 4_102_444_800  # 2100-01-01: larger values are not plausible receive times
@@ -119,8 +108,6 @@ _TRAILER_SEPARATORS = re.compile(r"[,\s]+")
 
 # A message's time: milliseconds since the epoch, and its source.
 _Stamp = tuple[int, TimeSource]
-# The time of a message kept without one (``keep_timeless``): a null timestamp in the tables.
-NO_TIME_MS = int(np.iinfo(np.int64).min)
 NO_TIME_SOURCE = "none"
 
 
@@ -189,32 +176,6 @@ class _Fragments:
             self.timestamp = timestamp
 
 
-@dataclass
-class _Columns:
-    """Decoded values as plain lists; sentinels are nulled later, on whole arrays."""
-
-    timestamp: list[int] = field(default_factory=list)  # milliseconds since the epoch
-    line_no: list[int] = field(default_factory=list)  # of the message's first sentence
-    mmsi: list[int] = field(default_factory=list)
-    msg_type: list[int] = field(default_factory=list)
-    lat: list[float | None] = field(default_factory=list)
-    lon: list[float | None] = field(default_factory=list)
-    sog: list[float | None] = field(default_factory=list)
-    cog: list[float | None] = field(default_factory=list)
-    heading: list[float | None] = field(default_factory=list)
-    rot_raw: list[float | None] = field(default_factory=list)
-    nav_status: list[float | None] = field(default_factory=list)
-    ship_type: list[float | None] = field(default_factory=list)
-    to_bow: list[float | None] = field(default_factory=list)
-    to_stern: list[float | None] = field(default_factory=list)
-    to_port: list[float | None] = field(default_factory=list)
-    to_starboard: list[float | None] = field(default_factory=list)
-    draught: list[float | None] = field(default_factory=list)
-    name: list[str | None] = field(default_factory=list)
-    callsign: list[str | None] = field(default_factory=list)
-    imo: list[float | None] = field(default_factory=list)
-
-
 _STATIC_ONLY = (
     "ship_type",
     "to_bow",
@@ -244,8 +205,8 @@ class _NmeaReader:
         self.time_sources = tuple(TimeSource(s) for s in time_sources)
         self.pending: dict[TimeSource, int] = {}
         self.open_groups: dict[tuple[str, str, int | None, int], _Fragments] = {}
-        self.positions = _Columns()
-        self.statics = _Columns()
+        self.positions = NmeaColumns()
+        self.statics = NmeaColumns()
 
     # -- lines ------------------------------------------------------------------------------
 
@@ -469,7 +430,7 @@ class _NmeaReader:
         )
 
 
-def _append_static_fields(columns: _Columns, decoded: Payload) -> None:
+def _append_static_fields(columns: NmeaColumns, decoded: Payload) -> None:
     ship_type = getattr(decoded, "ship_type", None)
     columns.ship_type.append(None if ship_type is None else int(ship_type))
     for name in ("to_bow", "to_stern", "to_port", "to_starboard"):
@@ -481,7 +442,7 @@ def _append_static_fields(columns: _Columns, decoded: Payload) -> None:
 
 
 def _append_static(
-    columns: _Columns, decoded: _StaticMessage, msg_type: int, timestamp: int
+    columns: NmeaColumns, decoded: _StaticMessage, msg_type: int, timestamp: int
 ) -> None:
     columns.timestamp.append(timestamp)
     columns.mmsi.append(decoded.mmsi)
@@ -568,188 +529,6 @@ def pghp_time_ms(text: str) -> int | None:
     return round(moment.timestamp()) * 1000 + millisecond
 
 
-# -- tables ---------------------------------------------------------------------------------
-
-
-def _floats(values: list[float | None]) -> np.ndarray:
-    return np.array(values, dtype=np.float64)
-
-
-def _null_where(values: np.ndarray, not_available: np.ndarray) -> np.ndarray:
-    return np.where(not_available, np.nan, values)
-
-
-def _dimension(first: np.ndarray, second: np.ndarray) -> np.ndarray:
-    """A+B (or C+D) only when both parts are reported; 0 means "not available"."""
-    return np.where((first > 0) & (second > 0), first + second, np.nan)
-
-
-def _count_implausible(columns: _Columns, source_name: str, ledger: RejectsLedger) -> None:
-    """Count the messages of ``columns`` whose length or breadth ``_static_frame`` drops as
-    implausible, with a valid MMSI (the pipeline rejects the others): ``implausible_dimension``."""
-    dimensions = (
-        _dimension(_floats(columns.to_bow), _floats(columns.to_stern)),
-        _dimension(_floats(columns.to_port), _floats(columns.to_starboard)),
-        _floats(columns.draught),
-    )
-    flagged = implausible(dimensions) & valid_mmsi(np.array(columns.mmsi, dtype=np.int64))
-    if not flagged.any():
-        return
-    first = int(np.flatnonzero(flagged)[0])
-    what = implausible_text(*(float(values[first]) for values in dimensions))
-    ledger.drop(
-        DropReason.IMPLAUSIBLE_DIMENSION,
-        int(flagged.sum()),
-        example=f"{source_name}:{columns.line_no[first]}: implausible dimension dropped "
-        f"({what}): MMSI {columns.mmsi[first]}",
-    )
-
-
-def _text(values: list[str | None]) -> pd.Series:
-    series = pd.Series(values, dtype=object)
-    return series.where(series.notna() & (series != "") & (series != "Unknown"), None)
-
-
-def _static_frame(columns: _Columns) -> pd.DataFrame:
-    """Static fields of ``columns`` with sentinels as nulls; ship_type stays numeric here."""
-    ship_type = _floats(columns.ship_type)
-    draught = _floats(columns.draught)
-    imo = _floats(columns.imo)
-    return pd.DataFrame(
-        {
-            "timestamp": np.array(columns.timestamp, dtype=np.int64),
-            "mmsi": np.array(columns.mmsi, dtype=np.int64),
-            "ship_type": _null_where(ship_type, ~(ship_type > 0)),
-            "length_m": null_outside(
-                _dimension(_floats(columns.to_bow), _floats(columns.to_stern)), 0.0, MAX_LENGTH_M
-            ),
-            "breadth_m": null_outside(
-                _dimension(_floats(columns.to_port), _floats(columns.to_starboard)),
-                0.0,
-                MAX_BREADTH_M,
-            ),
-            "draught_m": _null_where(draught, ~(draught > 0)),
-            "name": _text(columns.name),
-            "callsign": _text(columns.callsign),
-            "imo": _null_where(imo, ~(imo > 0)),
-        }
-    )
-
-
-_JOINED_FIELDS = ("ship_type", "length_m", "breadth_m", "draught_m", "name", "callsign", "imo")
-
-
-def _join_statics(positions: pd.DataFrame, statics: pd.DataFrame) -> pd.DataFrame:
-    """Fill each static field of ``positions`` from the nearest-in-time report that has it."""
-    if positions.empty or statics.empty:
-        return positions
-    ordered = positions.reset_index(names="_row").sort_values("timestamp", kind="stable")
-    for name in _JOINED_FIELDS:
-        source = statics.loc[statics[name].notna(), ["timestamp", "mmsi", name]]
-        if source.empty:
-            continue
-        nearest = pd.merge_asof(
-            ordered[["_row", "timestamp", "mmsi"]],
-            source.sort_values("timestamp", kind="stable").rename(columns={name: "_joined"}),
-            on="timestamp",
-            by="mmsi",
-            direction="nearest",
-        )
-        ordered[name] = ordered[name].where(ordered[name].notna(), nearest["_joined"].to_numpy())
-    return ordered.sort_values("_row").drop(columns="_row").reset_index(drop=True)
-
-
-def _ship_type_text(codes: pd.Series) -> pa.Array:
-    text = codes.map(lambda code: SHIP_TYPE_CATEGORIES.get(int(code)), na_action="ignore")
-    return pa.array(text.where(text.notna(), None), type=pa.string())
-
-
-def _timestamps(milliseconds: pd.Series) -> pa.Array:
-    """Milliseconds as timestamps; ``NO_TIME_MS`` (a message kept without a time) as null."""
-    values = milliseconds.to_numpy(dtype=np.int64)
-    missing = values == NO_TIME_MS
-    return pa.array(
-        values,
-        type=pa.timestamp("ms", tz="UTC"),
-        mask=missing if missing.any() else None,
-    )
-
-
-def _optional(values: pd.Series | np.ndarray, dtype: pa.DataType) -> pa.Array:
-    return pa.array(values, type=dtype, from_pandas=True)
-
-
-def _positions_table(
-    columns: _Columns, own_static: pd.DataFrame, statics: pd.DataFrame
-) -> pa.Table:
-    long_range = np.array(columns.msg_type, dtype=np.int64) == 27
-    lat = _floats(columns.lat)
-    lon = _floats(columns.lon)
-    sog = _floats(columns.sog)
-    cog = _floats(columns.cog)
-    heading = _floats(columns.heading)
-    rot_raw = _floats(columns.rot_raw)
-    # ±127 is "turning faster than 5°/30 s, no turn indicator": no rate is known.
-    rot_known = np.abs(rot_raw) <= 126
-    rot = np.where(rot_known, np.sign(rot_raw) * (rot_raw / 4.733) ** 2, np.nan)
-    positions = pd.DataFrame(
-        {
-            "timestamp": own_static["timestamp"],
-            "mmsi": own_static["mmsi"],
-            "lat_deg": _null_where(lat, ~(np.abs(lat) <= 90)),
-            "lon_deg": _null_where(lon, ~(np.abs(lon) <= 180)),
-            # Type 27 sends whole knots and degrees, with 63 and 511 as "not available".
-            "sog_kn": _null_where(sog, ~np.where(long_range, sog < 63, sog < 102.3)),
-            "cog_deg": _null_where(cog, ~(cog < 360)),
-            "heading_deg": _null_where(heading, ~(heading < 360)),
-            "rot_deg_per_min": rot,
-            "nav_status": _floats(columns.nav_status),
-            **own_static.drop(columns=["timestamp", "mmsi"]),
-        }
-    )
-    positions = _join_statics(positions, statics)
-    mobile_type = [_MOBILE_TYPE[t] for t in columns.msg_type]
-    return pa.table(
-        {
-            "timestamp": _timestamps(positions["timestamp"]),
-            "mmsi": pa.array(positions["mmsi"], type=pa.int64()),
-            "lat_deg": _optional(positions["lat_deg"], pa.float64()),
-            "lon_deg": _optional(positions["lon_deg"], pa.float64()),
-            "sog_kn": _optional(positions["sog_kn"], pa.float64()),
-            "cog_deg": _optional(positions["cog_deg"], pa.float64()),
-            "heading_deg": _optional(positions["heading_deg"], pa.float64()),
-            "rot_deg_per_min": _optional(positions["rot_deg_per_min"], pa.float64()),
-            "nav_status": _optional(positions["nav_status"], pa.int8()),
-            "ship_type": _ship_type_text(positions["ship_type"]),
-            "mobile_type": pa.array(mobile_type, type=pa.string()),
-            "length_m": _optional(positions["length_m"], pa.float64()),
-            "breadth_m": _optional(positions["breadth_m"], pa.float64()),
-            "draught_m": _optional(positions["draught_m"], pa.float64()),
-            "name": _optional(positions["name"], pa.string()),
-            "callsign": _optional(positions["callsign"], pa.string()),
-            "imo": _optional(positions["imo"], pa.int64()),
-        },
-        schema=CANONICAL_SCHEMA,
-    )
-
-
-def _statics_table(statics: pd.DataFrame) -> pa.Table:
-    return pa.table(
-        {
-            "timestamp": _timestamps(statics["timestamp"]),
-            "mmsi": pa.array(statics["mmsi"], type=pa.int64()),
-            "ship_type": _ship_type_text(statics["ship_type"]),
-            "length_m": _optional(statics["length_m"], pa.float64()),
-            "breadth_m": _optional(statics["breadth_m"], pa.float64()),
-            "draught_m": _optional(statics["draught_m"], pa.float64()),
-            "name": _optional(statics["name"], pa.string()),
-            "callsign": _optional(statics["callsign"], pa.string()),
-            "imo": _optional(statics["imo"], pa.int64()),
-        },
-        schema=STATIC_SCHEMA,
-    )
-
-
 def read_nmea(
     lines: Iterable[str],
     source_name: str,
@@ -772,16 +551,4 @@ def read_nmea(
     for line_no, line in enumerate(lines, start=1):
         reader.feed(line_no, line.lstrip("\ufeff") if line_no == 1 else line)
     reader.finish()
-    for columns in (reader.statics, reader.positions):  # positions: the type 19 fields
-        _count_implausible(columns, source_name, ledger)
-    statics = _static_frame(reader.statics)
-    # Type 19 positions carry static fields too; they fill other positions of that vessel.
-    position_statics = _static_frame(reader.positions)
-    is_type19 = np.array(reader.positions.msg_type, dtype=np.int64) == 19
-    join_source = pd.concat([statics, position_statics[is_type19]], ignore_index=True)
-    yield AisBatch(
-        positions=_positions_table(reader.positions, position_statics, join_source),
-        statics=_statics_table(statics),
-        position_lines=np.array(reader.positions.line_no, dtype=np.int64),
-        static_lines=np.array(reader.statics.line_no, dtype=np.int64),
-    )
+    yield nmea_batch(reader.positions, reader.statics, source_name, ledger)

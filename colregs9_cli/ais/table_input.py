@@ -1,6 +1,8 @@
 """Reading the files whose rows come as canonical tables through the row pipeline
 (row_pipeline.py): NMEA logs, decoded whole by nmea.py, and Parquet files with the canonical
-columns, read by batches of rows.
+columns, read by batches of rows. A Parquet file is cleaned again as a CSV is (its dimensions
+within the limits, A, B, C, D as ``clean.offset_parts`` has them); one written before the
+canonical schema had A, B, C, D is read with them null.
 """
 
 from __future__ import annotations
@@ -13,14 +15,19 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from ..errors import InputFileError
-from ..vessels import DIMENSIONS
+from ..vessels import DIMENSIONS, MAX_BREADTH_M, MAX_LENGTH_M
 from .batch import AisBatch
 from .clean import (
     DimensionColumns,
+    Dimensions,
     Fields,
+    OffsetParts,
     clean_text,
     is_vessel,
+    nan_to_null,
     null_outside,
+    offset_parts,
+    plausible,
     to_numpy_float,
     valid_mmsi,
 )
@@ -38,37 +45,95 @@ from .row_pipeline import (
     static_rows,
     time_out_of_range,
 )
-from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
+from .schema import ANTENNA_OFFSETS, CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from .sources import Source, decompression_error, open_data, sha256_file
 from .time_sources import ingest_params
 
 PARQUET_BATCH_ROWS = 256 * 1024
 
 
-def _canonical_fields(table: pa.Table) -> Fields:
+def _canonical_fields(table: pa.Table, offsets: bool = False) -> Fields:
+    """The fields of canonical rows. ``offsets``: their dimensions are measured with their
+    A, B, C, D (``_parquet_dimensions``: a Parquet file is cleaned again); else as stored
+    (decoded NMEA, cleaned by nmea_tables.py)."""
     mmsi = pc.fill_null(table.column("mmsi"), -1).to_numpy()
     n = table.num_rows
+    if offsets:
+        dimensions = DimensionColumns(
+            table.select([*DIMENSIONS, *ANTENNA_OFFSETS]), _parquet_dimensions
+        )
+    else:
+        dimensions = DimensionColumns(table.select(list(DIMENSIONS)), canonical_dimensions)
     return Fields(
         mmsi=np.asarray(mmsi, dtype=np.int64),
         lat_deg=null_outside(to_numpy_float(table.column("lat_deg")), -90.0, 90.0),
         lon_deg=null_outside(to_numpy_float(table.column("lon_deg")), -180.0, 180.0),
         vessel=is_vessel(table.column("mobile_type").combine_chunks()),
-        dimensions=DimensionColumns(table.select(list(DIMENSIONS)), canonical_dimensions),
+        dimensions=dimensions,
         unparseable=np.zeros(n, dtype=bool),
         problem=[],
     )
+
+
+def _parquet_offsets(table: pa.Table) -> OffsetParts:
+    a, b, c, d = (to_numpy_float(table.column(name)) for name in ANTENNA_OFFSETS)
+    return offset_parts(a, b, c, d)
+
+
+def _parquet_dimensions(table: pa.Table) -> Dimensions:
+    """A Parquet file's dimensions before the limits: as stored (the canonical columns are
+    the file's word), but from A, B, C, D (``clean.offset_parts``) where the stored one is
+    null, or where the parts alone are beyond the limits, so that such a row is counted as
+    implausible and its parts dropped rather than kept silently."""
+    return _parquet_measure(table, _parquet_offsets(table))
+
+
+def _parquet_measure(table: pa.Table, offsets: OffsetParts) -> Dimensions:
+    length_m, breadth_m, draught_m = canonical_dimensions(table)
+    with np.errstate(invalid="ignore"):
+        return (
+            np.where(
+                np.isnan(length_m) | (offsets.length_m > MAX_LENGTH_M), offsets.length_m, length_m
+            ),
+            np.where(
+                np.isnan(breadth_m) | (offsets.breadth_m > MAX_BREADTH_M),
+                offsets.breadth_m,
+                breadth_m,
+            ),
+            draught_m,
+        )
+
+
+def _parquet_canonical(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
+    """A Parquet file's rows cleaned as a reader cleans its rows: the implausible dimensions
+    dropped (``clean.plausible``, counted with the rows' block), and A, B, C, D as
+    ``clean.offset_parts`` cleans them, null where the row's length or breadth is dropped."""
+    table, bad_time = _canonical_identity(table)
+    offsets = _parquet_offsets(table)
+    measured = _parquet_measure(table, offsets)
+    cleaned = {
+        **dict(zip(DIMENSIONS, (nan_to_null(v) for v in plausible(measured)), strict=True)),
+        **offsets.columns(measured),
+    }
+    for name, column in cleaned.items():
+        table = table.set_column(table.schema.get_field_index(name), name, column)
+    return table, bad_time
 
 
 def _taker(table: pa.Table) -> Callable[[np.ndarray], Part]:
     return lambda rows: table.take(pa.array(rows, pa.int64()))
 
 
-def _table_conversion(name: str, static_text: StaticText | None) -> Conversion:
+def _table_conversion(
+    name: str,
+    static_text: StaticText | None,
+    canonical: Callable[[pa.Table], tuple[pa.Table, np.ndarray]] | None = None,
+) -> Conversion:
     def convert(parts: list[Part]) -> list[Converted]:
         table = pa.concat_tables(part for part in parts if isinstance(part, pa.Table))
         return [Converted(table, _table_example(name, table))]
 
-    return Conversion(convert, _canonical_identity, static_text)
+    return Conversion(convert, canonical or _canonical_identity, static_text)
 
 
 def _canonical_identity(table: pa.Table) -> tuple[pa.Table, np.ndarray]:
@@ -208,7 +273,7 @@ def read_parquet_file(read: FileRead) -> FileResult:
         raise InputFileError(
             f"{source.name}: a compressed Parquet file; give the .parquet file itself"
         )
-    conversion = _table_conversion(source.name, _canonical_static_text)
+    conversion = _table_conversion(source.name, _canonical_static_text, _parquet_canonical)
     result = FileResult(
         read.query, source.name, conversion, layout=read.layout.name, sink=read.sink
     )
@@ -217,20 +282,25 @@ def read_parquet_file(read: FileRead) -> FileResult:
     except (pa.ArrowException, OSError) as exc:
         raise InputFileError(f"{source.name}: not a readable Parquet file ({exc})") from None
     names = parquet.schema_arrow.names
-    missing = [c for c in CANONICAL_COLUMNS if c not in names]
+    # A, B, C, D may be absent: files written before the canonical schema had them.
+    required = [c for c in CANONICAL_COLUMNS if c not in ANTENNA_OFFSETS]
+    missing = [c for c in required if c not in names]
     if missing:
         raise InputFileError(
             f"{source.name}: the Parquet file lacks the canonical column {missing[0]!r}; "
-            f"it needs {', '.join(CANONICAL_COLUMNS)}"
+            f"it needs {', '.join(required)} (and may have {', '.join(ANTENNA_OFFSETS)})"
         )
     try:
         for record_batch in parquet.iter_batches(
-            batch_size=PARQUET_BATCH_ROWS, columns=list(CANONICAL_COLUMNS)
+            batch_size=PARQUET_BATCH_ROWS, columns=[c for c in CANONICAL_COLUMNS if c in names]
         ):
             table = _to_canonical(source, pa.Table.from_batches([record_batch]))
             result.ledger.read(table.num_rows)
             classify(
-                result, _canonical_fields(table), _taker(table), _table_example(result.name, table)
+                result,
+                _canonical_fields(table, offsets=True),
+                _taker(table),
+                _table_example(result.name, table),
             )
         result.settle()
     except (pa.ArrowException, OSError) as exc:
@@ -243,6 +313,9 @@ def read_parquet_file(read: FileRead) -> FileResult:
 def _to_canonical(source: Source, table: pa.Table) -> pa.Table:
     columns = []
     for target in CANONICAL_SCHEMA:
+        if target.name not in table.column_names:  # A, B, C, D of an older file
+            columns.append(pa.nulls(table.num_rows, target.type))
+            continue
         column = table.column(target.name)
         if pa.types.is_timestamp(column.type) and column.type.tz is None:
             column = column.cast(pa.timestamp(column.type.unit, tz="UTC"))

@@ -50,7 +50,7 @@ from .audit import (
 )
 from .colregs import ColregsEvaluation, ColregsParams, Kinematics, Role, evaluate_colregs
 from .encounters import Encounter, EncounterParams, encounter_series
-from .hull import UNKNOWN_OFFSETS, HullOffsets, centred_offsets, least_hull_distance_geodetic_m
+from .hull import HullOffsets, least_hull_distance_geodetic_m, offsets_from_ais
 from .interactions import (
     Interaction,
     InteractionKind,
@@ -71,7 +71,7 @@ from .manoeuvrability import (
 from .passing import Passing, PassingParams, horizon_steps, passing
 from .rule9 import Finding, PairVerdict, Rule9Assessment, Rule9Params, decide_pair
 from .rule9 import nav_status_finding as _finding
-from .tracks import Tracks
+from .tracks import ANTENNA_OFFSET_COLUMNS, Tracks
 from .vessel_defaults import DimensionDefaults, VesselDimensions, vessel_dimensions
 
 T = TypeVar("T")
@@ -143,24 +143,29 @@ class PairAudit:
     conducts: tuple[Conduct, Conduct]
     before_cpa_s: tuple[float | None, float | None]
     min_hull_separation_m: float | None = None
+    # Either hull's antenna placed by assumption, not by her AIS A, B, C, D (None: no hull
+    # distance).
+    hull_antenna_position_assumed: bool | None = None
 
 
-def hull_offsets(dimensions: VesselDimensions) -> HullOffsets:
-    """A vessel's hull around her antenna from her reported length and breadth, the antenna
-    assumed amidships on the centre line (the canonical schema does not yet carry AIS's
-    A/B/C/D); unknown when either dimension was not reported (a table default is no hull)."""
-    if "length_m" in dimensions.defaulted or "breadth_m" in dimensions.defaulted:
-        return UNKNOWN_OFFSETS
-    return centred_offsets(dimensions.length_m, dimensions.breadth_m)
+def hull_offsets(dimensions: VesselDimensions, static: dict[str, Any]) -> HullOffsets:
+    """A vessel's hull around her antenna: from her AIS A, B, C, D where her static row
+    (``_static``: the four from one report, ``tracks.latest_statics``) has them, else from
+    her reported length and breadth with the antenna amidships on the centre line, marked
+    ``defaulted`` (``hull.offsets_from_ais``); unknown when neither gives both the length and
+    the breadth (a table default is no hull)."""
+    length_m = None if "length_m" in dimensions.defaulted else dimensions.length_m
+    breadth_m = None if "breadth_m" in dimensions.defaulted else dimensions.breadth_m
+    a, b, c, d = (static.get(name) for name in ANTENNA_OFFSET_COLUMNS)
+    return offsets_from_ais(a, b, c, d, length_m, breadth_m)
 
 
 def least_hull_separation_m(
-    window: pd.DataFrame, dimensions: tuple[VesselDimensions, VesselDimensions]
+    window: pd.DataFrame, offsets: tuple[HullOffsets, HullOffsets]
 ) -> float | None:
-    """The least distance between the two hull outlines over ``window`` (rows of the pair's
-    series, headings true: COG where the heading was not reported); None where a hull is
-    unknown."""
-    offsets = tuple(hull_offsets(d) for d in dimensions)
+    """The least distance between the two hull outlines (``hull_offsets``) over ``window``
+    (rows of the pair's series, headings true: COG where the heading was not reported);
+    None where a hull is unknown."""
     if not all(o.known for o in offsets) or window.empty:
         return None
     a, b = PREFIXES
@@ -560,7 +565,7 @@ def rests_on_defaults(
 def _audit(
     window: pd.DataFrame,
     seen: Passing,
-    dimensions: tuple[VesselDimensions, VesselDimensions],
+    hulls: tuple[HullOffsets, HullOffsets],
     params: ConductParams,
     step_s: float,
 ) -> PairAudit:
@@ -569,7 +574,8 @@ def _audit(
             False, None, None, (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT), (None, None)
         )
     cpa_utc = window["timestamp"].iloc[seen.cpa_row]
-    hull_m = least_hull_separation_m(window.iloc[: seen.end_row + 1], dimensions)
+    hull_m = least_hull_separation_m(window.iloc[: seen.end_row + 1], hulls)
+    assumed = None if hull_m is None else any(h.defaulted for h in hulls)
     if not seen.covers_cpa:
         # The least range so far is observed, but the closest approach may lie past the data:
         # what the vessels did before it cannot be judged.
@@ -580,6 +586,7 @@ def _audit(
             (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT),
             (None, None),
             hull_m,
+            assumed,
         )
     until = window.iloc[: seen.cpa_row + 1]
     conducts = tuple(
@@ -600,6 +607,7 @@ def _audit(
         conducts=(conducts[0], conducts[1]),
         before_cpa_s=(before[0], before[1]),
         min_hull_separation_m=hull_m,
+        hull_antenna_position_assumed=assumed,
     )
 
 
@@ -633,7 +641,11 @@ def evaluate_pair(
         _Claims.of(_static(tracks.vessels, a), dimensions[0], params.claims),
         _Claims.of(_static(tracks.vessels, b), dimensions[1], params.claims),
     )
-    audit = _audit(window, seen, dimensions, params.conduct, step_s)
+    hulls = (
+        hull_offsets(dimensions[0], _static(tracks.vessels, a)),
+        hull_offsets(dimensions[1], _static(tracks.vessels, b)),
+    )
+    audit = _audit(window, seen, hulls, params.conduct, step_s)
     interaction = _interaction(tracks, oriented, encounter.trigger_step, params.interactions)
     steps = _pair_steps(series, dimensions, claims, chart, params, step_s)
     trigger = series.iloc[0]

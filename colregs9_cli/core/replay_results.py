@@ -6,8 +6,12 @@ import points down.
 
 from __future__ import annotations
 
+import dataclasses
+import types
+import typing
 from collections.abc import Sequence
 from dataclasses import dataclass
+from enum import Enum
 from pathlib import Path
 from typing import Any
 
@@ -25,12 +29,12 @@ from .rows import EncounterSummary, PairSummary, pair_row, seat_row, seat_series
 class EncounterOutcome:
     """One seat of a triggered pair: its row, time series and what its figure shows.
 
-    ``own_track``/``target_track`` (``north_m``, ``east_m``) cover the encounter and the
-    audit window after it; ``*_at_trigger_m`` are (north, east) at the trigger and
-    ``*_at_tcpa_m`` predicted at constant velocity from the trigger to TCPA; ``assessment`` is
-    the target's manoeuvrability at the trigger. These metres are in ``frame``: the run's
-    frame, or, for a pair beyond its reach (``geo.FRAME_REACH_M``), a frame centred on the
-    pair, where no chart and no arcs are drawn.
+    ``own_track``/``target_track`` (``timestamp`` UTC, ``lat_deg``, ``lon_deg``, ``north_m``,
+    ``east_m``) cover the encounter and the audit window after it; ``*_at_trigger_m`` are
+    (north, east) at the trigger and ``*_at_tcpa_m`` predicted at constant velocity from the
+    trigger to TCPA; ``assessment`` is the target's manoeuvrability at the trigger. These
+    metres are in ``frame``: the run's frame, or, for a pair beyond its reach
+    (``geo.FRAME_REACH_M``), a frame centred on the pair, where no chart and no arcs are drawn.
     """
 
     summary: EncounterSummary
@@ -95,6 +99,97 @@ class ReplayResult:
         """Every reported seat, ordered by start, own MMSI and target MMSI."""
         return seats_in_order(self.pairs)
 
+    @property
+    def pairs_table(self) -> pd.DataFrame:
+        """pairs.csv as a typed DataFrame (``summary_table``), a row per pair."""
+        return summary_table([pair.summary for pair in self.pairs], PairSummary)
+
+    @property
+    def encounters_table(self) -> pd.DataFrame:
+        """encounters.csv as a typed DataFrame (``summary_table``), a row per seat."""
+        return summary_table([seat.summary for seat in self.encounters], EncounterSummary)
+
+    @property
+    def tracks_table(self) -> pd.DataFrame:
+        """Both vessels' tracks of every seat (``tracks_table``), in the seats' order."""
+        return tracks_table(self.encounters)
+
+
+def _dtype(annotation: Any) -> Any:
+    """The pandas dtype of a summary field: ``X | None`` as a nullable X, enums as text."""
+    optional = isinstance(annotation, types.UnionType) and type(None) in typing.get_args(annotation)
+    if isinstance(annotation, types.UnionType):
+        annotation = next(a for a in typing.get_args(annotation) if a is not type(None))
+    if annotation is bool:
+        return "boolean" if optional else "bool"
+    if annotation is int:
+        return "Int64" if optional else "int64"
+    if annotation is float:
+        return "float64"
+    if annotation is pd.Timestamp:
+        return UTC_DTYPE
+    if annotation is str or (isinstance(annotation, type) and issubclass(annotation, Enum)):
+        return "str"
+    return "object"  # a field of another type: as it is (tests/test_api.py asks for types)
+
+
+# pandas' own resolution, that of the seats' series.
+UTC_DTYPE = pd.DatetimeTZDtype("us", "UTC")
+
+
+def summary_table(
+    summaries: Sequence[PairSummary | EncounterSummary], row: type[PairSummary | EncounterSummary]
+) -> pd.DataFrame:
+    """``summaries`` (rows of type ``row``) as pairs.csv/encounters.csv's columns, typed by
+    the fields: enums as their text, times as UTC timestamps, ``None`` as missing (nullable
+    integers and booleans). The dtypes do not depend on the values: a run without pairs
+    gives the same columns, empty."""
+    records = [
+        {
+            name: value.value if isinstance(value, Enum) else value
+            for name, value in dataclasses.asdict(summary).items()
+        }
+        for summary in summaries
+    ]
+    hints = typing.get_type_hints(row)
+    table = pd.DataFrame.from_records(records, columns=list(hints))
+    return table.astype({name: _dtype(hint) for name, hint in hints.items()})
+
+
+TRACK_COLUMNS: tuple[str, ...] = (
+    "encounter_id",
+    "pair_id",
+    "vessel",
+    "mmsi",
+    "timestamp",
+    "lat_deg",
+    "lon_deg",
+    "north_m",
+    "east_m",
+)
+
+
+def tracks_table(seats: Sequence[EncounterOutcome]) -> pd.DataFrame:
+    """Own ship's then the target's track of each seat, one row per time step
+    (``TRACK_COLUMNS``; ``vessel`` is ``own`` or ``target``). The metres are in each seat's
+    ``frame``: the run's, or the pair's own beyond its reach (``in_run_frame``)."""
+    parts = [
+        track.assign(
+            encounter_id=seat.summary.encounter_id,
+            pair_id=seat.summary.pair_id,
+            vessel=vessel,
+            mmsi=getattr(seat.summary, f"{vessel}_mmsi"),
+        )
+        for seat in seats
+        for vessel, track in (("own", seat.own_track), ("target", seat.target_track))
+    ]
+    columns = list(TRACK_COLUMNS)
+    table = pd.concat(parts, ignore_index=True)[columns] if parts else pd.DataFrame(columns=columns)
+    types_by_column: dict[str, Any] = dict.fromkeys(("encounter_id", "pair_id", "vessel"), "str")
+    types_by_column |= {"mmsi": "int64", "timestamp": UTC_DTYPE}
+    types_by_column |= dict.fromkeys(("lat_deg", "lon_deg", "north_m", "east_m"), "float64")
+    return table.astype(types_by_column)
+
 
 def seats_in_order(pairs: Sequence[PairOutcome]) -> tuple[EncounterOutcome, ...]:
     """The pairs' seats ordered by start, own MMSI and target MMSI: the order of the reports'
@@ -150,11 +245,15 @@ def seat_outcome(seat: Seat, pair: PairSummary, run_frame: LocalFrame) -> Encoun
         return float(north), float(east)
 
     def track(prefix: str) -> pd.DataFrame:
+        # The time and the position on the Earth beside the metres, for tables and maps.
+        track = full[["timestamp", f"{prefix}lat_deg", f"{prefix}lon_deg"]].set_axis(
+            ["timestamp", "lat_deg", "lon_deg"], axis=1
+        )
         if in_run_frame:
-            metres = full[[f"{prefix}north_m", f"{prefix}east_m"]]
-            return metres.set_axis(["north_m", "east_m"], axis=1)
-        north, east = frame.to_local(full[f"{prefix}lat_deg"], full[f"{prefix}lon_deg"])
-        return pd.DataFrame({"north_m": north, "east_m": east}, index=full.index)
+            north, east = full[f"{prefix}north_m"], full[f"{prefix}east_m"]
+        else:
+            north, east = frame.to_local(track["lat_deg"], track["lon_deg"])
+        return track.assign(north_m=north, east_m=east)
 
     own_prefix, target_prefix = seat.prefixes
     own, target = seat.own, seat.target

@@ -396,9 +396,7 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         actual_min_separation_m=pair.audit.min_separation_m,
         actual_min_separation_utc=pair.audit.cpa_utc,
         actual_min_separation_hull_m=pair.audit.min_hull_separation_m,
-        hull_antenna_position_assumed=(
-            None if pair.audit.min_hull_separation_m is None else True  # no A/B/C/D yet
-        ),
+        hull_antenna_position_assumed=pair.audit.hull_antenna_position_assumed,
         give_way_vessel_acted=all_of(v.conduct.changed for v in give_way) if give_way else None,
         give_way_action=_joined([v.conduct.action.value for v in give_way]),
         give_way_action_as_rule_asks=pair.give_way_action_as_rule_asks,

@@ -97,6 +97,9 @@ REQUIRED_COLUMNS: tuple[str, ...] = (
     "heading_deg",
     "nav_status",
 )
+# AIS A, B, C, D (the canonical schema's names): the antenna's distances to the bow, stern,
+# port and starboard sides, taken together from one report (``latest_statics``).
+ANTENNA_OFFSET_COLUMNS: tuple[str, ...] = ("to_bow_m", "to_stern_m", "to_port_m", "to_starboard_m")
 STATIC_COLUMNS: tuple[str, ...] = (
     "name",
     "callsign",
@@ -105,6 +108,7 @@ STATIC_COLUMNS: tuple[str, ...] = (
     "mobile_type",
     "length_m",
     "breadth_m",
+    *ANTENNA_OFFSET_COLUMNS,
     "draught_m",
 )
 # A vessel's resampled state at a step (true courses for reports, grid courses for geometry).
@@ -683,15 +687,32 @@ def _resample(
 
 def latest_statics(positions: pd.DataFrame, earlier: pd.DataFrame | None = None) -> pd.DataFrame:
     """Each vessel's last non-null value of each static column in ``positions``, else its
-    value in ``earlier`` (the same from earlier positions), indexed by MMSI."""
+    value in ``earlier`` (the same from earlier positions), indexed by MMSI.
+
+    The antenna offsets (``ANTENNA_OFFSET_COLUMNS``) are taken together, all four from her
+    last report with any of them (its nulls kept), else all four from ``earlier``: A from
+    one report and B from another could draw a hull no report described."""
     present = [c for c in STATIC_COLUMNS if c in positions.columns]
+    offsets = [c for c in ANTENNA_OFFSET_COLUMNS if c in present]
     ordered = positions.sort_values("timestamp", kind="stable")
-    latest = ordered.groupby("mmsi")[present].last()
+    latest = ordered.groupby("mmsi")[[c for c in present if c not in offsets]].last()
+    if offsets:
+        reported = ordered[ordered[offsets].notna().any(axis=1)]
+        last = reported.drop_duplicates("mmsi", keep="last").set_index("mmsi")[offsets]
+        latest = latest.join(last)[present]
     if earlier is None or earlier.empty:
         return latest
     if latest.empty:
         return earlier
-    return latest.combine_first(earlier)[present]
+    combined = latest.combine_first(earlier)[present]
+    together = [c for c in offsets if c in earlier.columns]
+    if together:
+        # combine_first fills column by column: where the latest positions report any
+        # offset, all four are theirs.
+        own = latest[together].notna().any(axis=1)
+        rows = own.index[own.to_numpy()]
+        combined.loc[rows, together] = latest.loc[rows, together]
+    return combined
 
 
 def vessel_statics(

@@ -10,17 +10,27 @@ are drawn there too.
 
 On a cluster of several machines every worker must read the run's scratch directory (the
 spilled reports): give ``--scratch`` on a file system they all mount.
+
+A local cluster leaves no file behind (``cluster_scratch``): its workers' directories and
+Dask's lock files, and the socket of multiprocessing's forkserver, go into temporary
+directories that are removed when it closes; the console script's quick exit
+(``quick_exit``) would skip multiprocessing's own removal of its ``pymp-*`` directory.
 """
 
 from __future__ import annotations
 
 import logging
 import multiprocessing
+import shutil
+import tempfile
+import threading
+import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import ExitStack, closing, contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
+from multiprocessing import forkserver
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -40,11 +50,89 @@ from .slabs import PairEvaluator, SlabContext, SlabResult, replay_slab, slab_lab
 Part = TypeVar("Part")
 # How long to wait for a scheduler given with --scheduler before giving up.
 _CONNECT_TIMEOUT_S = 10
+# After a failure, how long to wait for the tasks running on the workers to end (a figure or
+# a slab's series take seconds), before the report's staging directory is removed.
+_SETTLE_TIMEOUT_S = 60
+_SETTLE_POLL_S = 0.05
+# The local clusters open in this process, and the directory that this module gave
+# multiprocessing for its temporary files (the forkserver's socket) while they run.
+_clusters_lock = threading.Lock()
+_clusters_open = 0
+_multiprocessing_dir: Path | None = None
 
 
 @contextmanager
-def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
-    """A client of the cluster at ``scheduler``, else of a new local cluster."""
+def cluster_scratch(parent: Path | None) -> Iterator[Path]:
+    """A new directory in ``parent`` (default: the system's temporary directory) for a local
+    cluster's files (its workers' directories, Dask's lock files, the workers' ``TMPDIR``),
+    removed with all it holds on leaving, once the cluster has closed. Multiprocessing's
+    temporary directory of this process, where the forkserver that starts the workers has
+    its socket, is one of colregs9's too while clusters are open (``_enter_cluster``)."""
+    try:
+        local_dir = Path(tempfile.mkdtemp(prefix="colregs9-dask-", dir=parent))
+    except OSError as exc:
+        where = f"--scratch {parent}" if parent is not None else "the temporary directory"
+        raise ParameterError(
+            f"{where}: cannot make the Dask workers' directory there ({exc.strerror}); give a "
+            "writable directory with --scratch"
+        ) from None
+    try:
+        _enter_cluster()
+        try:
+            yield local_dir
+        finally:
+            _leave_cluster()
+    finally:
+        shutil.rmtree(local_dir, ignore_errors=True)
+
+
+def _forkserver() -> Any:
+    # multiprocessing's own forkserver of this process (private: Python has no public API).
+    return getattr(forkserver, "_forkserver", None)
+
+
+def _enter_cluster() -> None:
+    """Before the first of this process's open local clusters, if multiprocessing has made
+    no temporary directory yet and runs no forkserver: give it a directory of colregs9's
+    (``colregs9-mp-*`` in the system's temporary directory: the socket's path must stay
+    short), which ``_leave_cluster`` removes."""
+    global _clusters_open, _multiprocessing_dir
+    with _clusters_lock:
+        config: dict[str, Any] = getattr(multiprocessing.current_process(), "_config", {})
+        server = _forkserver()
+        idle = server is None or getattr(server, "_forkserver_pid", None) is None
+        if _clusters_open == 0 and config.get("tempdir") is None and idle:
+            _multiprocessing_dir = Path(tempfile.mkdtemp(prefix="colregs9-mp-"))
+            config["tempdir"] = str(_multiprocessing_dir)
+        _clusters_open += 1
+
+
+def _leave_cluster() -> None:
+    """After the last open local cluster: stop the forkserver started for the clusters (its
+    socket is in the directory ``_enter_cluster`` gave; this process's next cluster starts
+    another), give multiprocessing back its own temporary directory, and remove colregs9's."""
+    global _clusters_open, _multiprocessing_dir
+    with _clusters_lock:
+        _clusters_open -= 1
+        if _clusters_open or _multiprocessing_dir is None:
+            return
+        ours, _multiprocessing_dir = _multiprocessing_dir, None
+        stop = getattr(_forkserver(), "_stop", None)
+        if stop is not None:
+            stop()
+        config: dict[str, Any] = getattr(multiprocessing.current_process(), "_config", {})
+        if config.get("tempdir") == str(ours):
+            config["tempdir"] = None
+        shutil.rmtree(ours, ignore_errors=True)
+
+
+@contextmanager
+def dask_client(
+    workers: int, scheduler: str | None, scratch_dir: Path | None = None
+) -> Iterator[Client]:
+    """A client of the cluster at ``scheduler``, else of a new local cluster, whose temporary
+    files go into ``scratch_dir`` (default: the system's temporary directory) and are
+    removed when it closes (``cluster_scratch``)."""
     if scheduler is not None:
         try:
             client = Client(scheduler, timeout=_CONNECT_TIMEOUT_S)
@@ -73,17 +161,29 @@ def dask_client(workers: int, scheduler: str | None) -> Iterator[Client]:
     }
     if "forkserver" in multiprocessing.get_all_start_methods():
         settings["distributed.worker.multiprocessing-method"] = "forkserver"
-    with dask.config.set(settings):
-        cluster = LocalCluster(
-            n_workers=workers,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            # The scheduler's HTTP server starts even without a dashboard, on 8787 unless
-            # told otherwise, and warns on stderr when another cluster holds that port.
-            scheduler_kwargs={"dashboard_address": ":0"},
-            silence_logs=logging.ERROR,
-        )
+    with cluster_scratch(scratch_dir) as local_dir:
+        settings["temporary-directory"] = str(local_dir)
+        with dask.config.set(settings):
+            cluster = LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                # The scheduler's HTTP server starts even without a dashboard, on 8787 unless
+                # told otherwise, and warns on stderr when another cluster holds that port.
+                scheduler_kwargs={"dashboard_address": ":0"},
+                silence_logs=logging.ERROR,
+                local_directory=str(local_dir),
+                # What the workers' own temporary files would leave, in the same place.
+                env={"TMPDIR": str(local_dir)},
+            )
+        with _local_cluster(cluster) as client:
+            yield client
+
+
+@contextmanager
+def _local_cluster(cluster: LocalCluster) -> Iterator[Client]:
+    """A client of the local ``cluster``, both closed on leaving."""
     # Not made the default client: that is a context variable of the thread that starts it
     # (``dask_client_soon``), and the run's own thread uses and closes it.
     with closing(cluster), closing(Client(cluster, set_as_default=False)) as client:
@@ -111,7 +211,9 @@ def _seldom_collected(function: Callable[..., Part], /, *args: Any, **kwargs: An
 
 
 @contextmanager
-def dask_client_soon(workers: int, scheduler: str | None) -> Iterator[Callable[[], Client]]:
+def dask_client_soon(
+    workers: int, scheduler: str | None, scratch_dir: Path | None = None
+) -> Iterator[Callable[[], Client]]:
     """``dask_client``, started while the caller goes on: yields a function that waits for
     the client. A scheduler given by address is reached at once, so that an unreachable one
     stops the run before any work; a local cluster starts on a thread (importing Dask and
@@ -122,7 +224,7 @@ def dask_client_soon(workers: int, scheduler: str | None) -> Iterator[Callable[[
         return
     with ExitStack() as stack, ThreadPoolExecutor(max_workers=1) as pool:
         # Leaving waits for the start, then closes the cluster, even after an error.
-        yield pool.submit(stack.enter_context, dask_client(workers, None)).result
+        yield pool.submit(stack.enter_context, dask_client(workers, None, scratch_dir)).result
 
 
 def dask_slabs(
@@ -135,7 +237,9 @@ def dask_slabs(
 ) -> tuple[list[SlabResult], EncountersOnCluster]:
     """``slabs.replay_slab`` for every slab on the cluster of ``client``, in slab order;
     and the slabs' results left on the workers, for the reports."""
-    shared = client.scatter([context, chart], broadcast=True)
+    # hash=False: a chart of None (or the same context) scattered twice in a run would share
+    # one key, and the release of the first would race the second ("lost dependencies").
+    shared = client.scatter([context, chart], broadcast=True, hash=False)
     futures = client.map(
         partial(_seldom_collected, replay_slab),
         list(slabs),
@@ -162,6 +266,7 @@ class EncountersOnCluster:
 
     client: Client
     slabs: tuple[Future, ...]
+    submitted: list[Future] = field(default_factory=list, compare=False)
 
     def map(
         self, function: Callable[[tuple[EncounterOutcome, ...]], Part]
@@ -170,7 +275,41 @@ class EncountersOnCluster:
             self.client.submit(_seldom_collected, _on_seats, function, slab, pure=False)
             for slab in self.slabs
         ]
+        self.submitted.extend(futures)
         return [future.result for future in futures]
+
+    def settle(self) -> None:
+        """Drop the parts' tasks not begun, and wait for those running (``settle_tasks``)."""
+        settle_tasks(self.client, self.submitted)
+
+
+# A task in one of these states on a worker runs no more: done, failed or let go.
+_SETTLED_STATES = frozenset({"memory", "error", "released", "forgotten"})
+
+
+def settle_tasks(client: Client, futures: Sequence[Future]) -> None:
+    """Cancel ``futures`` and return once no worker runs or holds one of them any more (or
+    after ``_SETTLE_TIMEOUT_S``): a running task cannot be stopped, and one a worker holds
+    ready would start before the cancellation reaches it. Used after a failure, before the
+    report's staging directory, which the tasks write into, is removed."""
+    keys = {future.key for future in futures}
+    try:
+        client.cancel(list(futures))
+        deadline_s = time.monotonic() + _SETTLE_TIMEOUT_S
+        while time.monotonic() < deadline_s:
+            held = client.run(_unsettled_keys)
+            if not keys.intersection(key for found in held.values() for key in found):
+                return
+            time.sleep(_SETTLE_POLL_S)
+    except Exception:  # a cluster that is gone or broken runs no task that writes
+        return
+
+
+def _unsettled_keys(dask_worker: Any) -> list[Any]:
+    """On a worker (``Client.run``): the keys of its tasks that may still run."""
+    return [
+        task.key for task in dask_worker.state.tasks.values() if task.state not in _SETTLED_STATES
+    ]
 
 
 def _on_seats(function: Callable[[tuple[EncounterOutcome, ...]], Part], slab: SlabResult) -> Part:
@@ -188,7 +327,7 @@ def dask_drawer(client: Client) -> Drawer:
         frame: LocalFrame,
         progress: ProgressSink,
     ) -> None:
-        (shared,) = client.scatter([chart], broadcast=True)
+        (shared,) = client.scatter([chart], broadcast=True, hash=False)
         # The encounters travel in the task graph (about 0.2 MB each), which distributed
         # would warn about on stderr from 10 MB; scattering them first lost them now and
         # then ("lost dependencies") on a two-worker LocalCluster.
@@ -202,9 +341,13 @@ def dask_drawer(client: Client) -> Drawer:
                 frame=frame,
                 pure=False,
             )
-        for future in as_completed(futures, loop=client.loop):
-            future.result()
-            progress.advance()
+        try:
+            for future in as_completed(futures, loop=client.loop):
+                future.result()
+                progress.advance()
+        except BaseException:
+            settle_tasks(client, futures)  # none writes into the staging once it is gone
+            raise
 
     return draw
 

@@ -23,6 +23,7 @@ The inputs (the two scenarios, the modelled chart and the query) are package dat
 from __future__ import annotations
 
 import dataclasses
+import json
 import shutil
 from dataclasses import dataclass
 from enum import Enum
@@ -32,7 +33,7 @@ from pathlib import Path
 from ..charts.provenance import charts_manifest
 from ..core.replay_results import EncounterOutcome, ReplayResult
 from ..errors import InputFileError, NoDataError
-from ..outputs import REPORT_MARKER, check_out_dir, report_directory, write_json
+from ..outputs import FILES_KEY, REPORT_MARKER, check_out_dir, report_directory, write_json
 from ..provenance import run_header
 from ..report.replay_report import ENCOUNTER_DIR
 from ..timebase import DISPLAY_TIME_FORMAT
@@ -263,10 +264,11 @@ def run_demo(
     """Both Greenhopper scenarios: simulate, replay, and the verdicts (module docstring).
 
     Errors: a missing scenario directory, scenario file, chart or query (``InputFileError``,
-    exit 2); an ``out_dir`` that cannot take a report, or holds something other than a
-    colregs9 report and ``overwrite`` is false (``OutputError``, exit 2), both before any
-    work; a scenario whose replay has no triggered encounter for own ship (``NoDataError``,
-    exit 3), which leaves ``out_dir`` as it was.
+    exit 2); an ``out_dir`` that cannot take a report, or, unless ``overwrite``, holds a
+    report of another command or files colregs9 did not write (``OutputError``, exit 2,
+    ``outputs.check_out_dir``), both before any work; a scenario whose replay has no
+    triggered encounter for own ship (``NoDataError``, exit 3), which leaves ``out_dir`` as
+    it was.
     """
     target = out_dir if out_dir is not None else DEFAULT_OUT_DIR
     _require(scenarios_dir, "--scenarios", "directory")
@@ -275,13 +277,15 @@ def run_demo(
     paths = [scenarios_dir / f"{name}.toml" for name in SCENARIO_NAMES]
     for path in paths:
         _require(path, "--scenarios", "file")
-    check_out_dir(target, overwrite)
-    with report_directory(target) as staging:
+    check_out_dir(target, overwrite, command="demo")
+    with report_directory(target, overwrite) as staging:
         staged = tuple(run_scenario(path, staging, chart, query, quiet) for path in paths)
         verdicts = tuple(_moved(verdict, staging, target) for verdict in staged)
         for staged_verdict, verdict in zip(staged, verdicts, strict=True):
             # Each replay read its AIS in the staging directory; its run.json is to name the
-            # file where it stays, beside the report.
-            write_json(staged_verdict.replay.out_dir / REPORT_MARKER, verdict.replay.manifest)
+            # file where it stays, beside the report, and still list the replay's files.
+            staged_json = staged_verdict.replay.out_dir / REPORT_MARKER
+            files = json.loads(staged_json.read_text(encoding="utf-8"))[FILES_KEY]
+            write_json(staged_json, {**verdict.replay.manifest, FILES_KEY: files})
         write_json(staging / REPORT_MARKER, demo_manifest(verdicts, paths, chart, query))
     return DemoResult(out_dir=target, verdicts=verdicts)

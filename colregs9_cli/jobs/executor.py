@@ -52,7 +52,12 @@ class Executor(Protocol):
         ...
 
     def write_reports(
-        self, result: ReplayResult, chart: Chart | None, plots: bool, bar: ProgressSink
+        self,
+        result: ReplayResult,
+        chart: Chart | None,
+        plots: bool,
+        bar: ProgressSink,
+        overwrite: bool = False,
     ) -> tuple[Path, ...]:
         """The report files, written whole (``report.replay_report.write_replay_reports``)."""
         ...
@@ -78,9 +83,14 @@ class LocalExecutor:
         return run_slabs(slabs, context, evaluate, chart, bar)
 
     def write_reports(
-        self, result: ReplayResult, chart: Chart | None, plots: bool, bar: ProgressSink
+        self,
+        result: ReplayResult,
+        chart: Chart | None,
+        plots: bool,
+        bar: ProgressSink,
+        overwrite: bool = False,
     ) -> tuple[Path, ...]:
-        return write_replay_reports(result, chart, plots, bar)
+        return write_replay_reports(result, chart, plots, bar, overwrite=overwrite)
 
 
 class DaskExecutor:
@@ -115,24 +125,34 @@ class DaskExecutor:
         return results
 
     def write_reports(
-        self, result: ReplayResult, chart: Chart | None, plots: bool, bar: ProgressSink
+        self,
+        result: ReplayResult,
+        chart: Chart | None,
+        plots: bool,
+        bar: ProgressSink,
+        overwrite: bool = False,
     ) -> tuple[Path, ...]:
         from .dask_run import dask_drawer
 
         drawer = dask_drawer(self._client())
-        return write_replay_reports(result, chart, plots, bar, drawer, self._on_cluster)
+        return write_replay_reports(
+            result, chart, plots, bar, drawer, self._on_cluster, overwrite=overwrite
+        )
 
 
 @contextmanager
-def executor(workers: int, scheduler: str | None) -> Iterator[Executor]:
+def executor(
+    workers: int, scheduler: str | None, scratch_dir: Path | None = None
+) -> Iterator[Executor]:
     """This process for one worker and no scheduler; else a Dask cluster, started at once
     (so that an unreachable scheduler stops the run before any work; a local cluster starts
-    beside the reading) and closed on leaving. Dask is imported only then: it takes a
-    second."""
+    beside the reading, with its temporary files in ``scratch_dir``, default the system's
+    temporary directory, removed when it closes) and closed on leaving. Dask is imported
+    only then: it takes a second."""
     if workers == 1 and scheduler is None:
         yield LocalExecutor()
         return
     from .dask_run import dask_client_soon
 
-    with dask_client_soon(workers, scheduler) as client:
+    with dask_client_soon(workers, scheduler, scratch_dir) as client:
         yield DaskExecutor(client)

@@ -8,14 +8,16 @@ Layout (``OUT`` is the dataset directory)::
 
 ``<sha16>`` is the first 16 hex digits of the input file's sha256, ``<n>`` counts the input's
 files in that partition (a new file starts, at an hour boundary, past ``FILE_ROWS``). The
-files hold the canonical schema (``schema.CANONICAL_SCHEMA``; the partition gives ``date``),
-zstd-compressed, in row groups of ``ROW_GROUP_ROWS``. Within a file the positions come
-first, sorted by (hour of timestamp, floor(lat_deg), floor(lon_deg), mmsi, timestamp), so
-that each row group covers about one hour and a band of latitudes: the statistics on
-timestamp, lat_deg and lon_deg let a time and region query skip most row groups. Then the
-static reports (rows without a position that carry static fields, load.py step 4, with
-null lat/lon), in their own row groups, sorted by (hour, mmsi, timestamp): ``stats`` counts
-their dimensions as it does in the files.
+files hold the canonical schema (``schema.CANONICAL_SCHEMA``, format version 2; the
+partition gives ``date``), zstd-compressed, in row groups of ``ROW_GROUP_ROWS``. An ingest
+into a version 1 dataset (files without A, B, C, D) adds its inputs so, and records each
+input's version in the manifest, then of version 2 (dataset_scan.py reads both). Within a
+file the positions come first, sorted by (hour of timestamp, floor(lat_deg), floor(lon_deg),
+mmsi, timestamp), so that each row group covers about one hour and a band of latitudes: the
+statistics on timestamp, lat_deg and lon_deg let a time and region query skip most row
+groups. Then the static reports (rows without a position that carry static fields, load.py
+step 4, with null lat/lon), in their own row groups, sorted by (hour, mmsi, timestamp):
+``stats`` counts their dimensions as it does in the files.
 
 The rows are those ``load_ais`` would use under the ingest query (everything by default):
 cleaned the same way, exact duplicates dropped, with the same rejects ledger. Reading the
@@ -81,7 +83,7 @@ from ..ais.schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from ..ais.sources import Source, inspect_source, sha256_file
 from ..ais.time_sources import ingest_params
 from ..errors import InputFileError, NoDataError, OutputError, ParameterError
-from ..outputs import write_json
+from ..outputs import report_manifest, write_json
 from ..progress import ProgressSink, progress_bar, progress_enabled
 from ..provenance import query_manifest
 from ..query import Query, everything_query, load_query
@@ -276,6 +278,12 @@ def _dataset_inputs(out_dir: Path) -> list[DatasetInput]:
     if (out_dir / MANIFEST_NAME).exists():
         return read_manifest(out_dir)
     ours = (LOCK_NAME, ".ingest-")  # the lock, and staging a killed ingest left
+    report = report_manifest(out_dir) if out_dir.is_dir() else None
+    if report is not None:  # a dataset is added to, never mixed with a report
+        raise OutputError(
+            f"{out_dir}: --out holds a colregs9 {report.get('command')} report, not a dataset; "
+            "give a new or empty directory, or a dataset made by colregs9 ingest"
+        )
     if out_dir.is_dir() and any(not p.name.startswith(ours) for p in out_dir.iterdir()):
         raise OutputError(
             f"{out_dir}: --out holds files but no {MANIFEST_NAME}, so it is not a colregs9 "
@@ -341,6 +349,7 @@ def _ingest_one(
         partitions[item.date or UNDATED] += item.rows
     return {
         "path": str(source.path),
+        "format_version": FORMAT_VERSION,  # its files' schema (dataset_scan.FILE_SCHEMAS)
         "sha256": sha256,
         "size_bytes": source.size_bytes,
         "layout": streamed.layout,

@@ -247,13 +247,13 @@ def run_replay(
             f"--scratch {scratch_dir}: not a directory; give an existing directory (on a "
             "multi-machine cluster, one that every worker mounts)"
         )
-    with executor(workers, scheduler) as runner:
+    with executor(workers, scheduler, scratch_dir) as runner:
         query = load_query(query_path) if query_path is not None else everything_query()
         params = run_params(query, own_mmsi, overrides)
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
         if write:
             given = [*ais_paths, *chart_paths, *([query_path] if query_path else [])]
-            check_out_dir(target, overwrite, inputs=given)
+            check_out_dir(target, overwrite, inputs=given, command="replay")
         with _scratch_directory(scratch_dir) as scratch:
             spill_dir = Path(scratch) / "spill"
             spill_dir.mkdir()
@@ -328,7 +328,7 @@ def run_replay(
         files: tuple[Path, ...] = ()
         if write:
             with progress_bar("Reports", len(result.encounters), progress_enabled(quiet)) as bar:
-                files = runner.write_reports(result, chart, plots, bar)
+                files = runner.write_reports(result, chart, plots, bar, overwrite)
         return dataclasses.replace(result, files=files, text=format_summary(result))
 
 

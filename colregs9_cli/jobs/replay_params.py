@@ -124,7 +124,7 @@ class ReplayParams:
     @property
     def encounters(self) -> EncounterParams:
         return EncounterParams(
-            self.min_sog_kn, self.candidate_range_m, self.tcpa_act_s, self.cpa_req_m
+            self.min_sog_kn, self.candidate_range_m, self.tcpa_act_s, self.cpa_req_m, self.passing
         )
 
     @property
@@ -212,7 +212,10 @@ class ReplayParams:
                 "that (2 nm, 3704 m, is the default)"
             )
         window_steps = (
-            self.slab_s + self.tcpa_act_s + self.passing_follow_s + 60.0 + 4.0 * self.max_gap_s
+            self.slab_s
+            + 2.0 * (self.tcpa_act_s + self.passing_follow_s)
+            + 60.0
+            + 4.0 * self.max_gap_s
         ) / self.step_s
         if window_steps > MAX_STEPS_PER_SLAB:
             raise ParameterError(

@@ -16,10 +16,22 @@ order and in any process): a slab owns the encounters that start in its core, ``
 (``Spill.read``, with ``pyarrow.dataset``'s filters), resamples only the vessels under way
 there (``tracks.resample_reports``), searches the pairs, and evaluates its triggered pairs
 (``replay.evaluate_pair`` is handed in by the caller). The window reaches before the core by
-one step plus the context the resampling needs, so an encounter that started earlier is seen
-to have started earlier; and after it by a tail that holds most encounters whole. An
-encounter still going on at the window's end (two vessels sailing together for hours) is
-followed for its two vessels alone, in windows that double, until it ends or the data does.
+``lead_steps``: the longest follow window of a passing (``EncounterParams.chain_steps``), so
+that every firing step that could keep an earlier passing open at a run starting in the core
+is seen, and at least the interaction's window plus one step, so that an encounter that
+started earlier is seen to have started earlier. After the core it reaches by a tail that
+holds most encounters whole.
+
+Whether a step starts an encounter depends on the pair's passings before it
+(``encounters.py``): a run that starts while a passing is open joins it, and an open passing
+splits its run where it has opened and the pair fires again. That history can be longer than
+any window (two vessels in company for hours, passing and passing again). So a pair is taken
+as the window shows it only where its encounters there are settled (``_needs``): each that
+reaches into the core comes from a chain that starts inside the window's reach
+(``Encounter.chain_start_step``), or the pair fires nowhere in the window and its runs through
+the core end in it; and each that starts in the core, or that opened in it and may yet split
+there, is whole. The other pairs are searched again for their two vessels alone, in windows
+that double before the core, after it, or both, until they are settled or the data ends.
 
 What is exact: every sample a slab uses is the sample one go would make (same reports, same
 neighbours), so the encounters, verdicts and counts do not depend on the slab length or on
@@ -350,13 +362,25 @@ class SlabResult:
     encounters: int
     triggered: int
     samples: int
-    followed: int  # pairs followed past the slab's window
+    followed: int  # pairs with an owned encounter followed past the slab's window
+    looked_back: int = 0  # pairs whose history was read from before the slab's window
 
 
 def tail_steps(params: ReplayParams) -> int:
     """How far past its core a slab's window reaches: a trigger at the end of the core, its
     TCPA (at most TCPA_act), the passing followed past it, and a minute."""
     return math.ceil((params.tcpa_act_s + params.passing_follow_s + 60.0) / params.step_s)
+
+
+def lead_steps(params: ReplayParams) -> int:
+    """How far before its core a slab's window reaches: the longest follow window of a
+    passing (an earlier firing step this far back may keep a passing open at a run that
+    starts in the core), and at least the interaction's window before a trigger at the
+    core's start and a step (to see whether a run starts there)."""
+    return max(
+        params.encounters.chain_steps(params.step_s),
+        window_steps(params.interactions, params.step_s) + 1,
+    )
 
 
 def _tracks(job: SlabContext, steps: tuple[int, int], mmsis: Sequence[int] | None) -> Tracks:
@@ -393,40 +417,92 @@ def _whole(encounter: Encounter, last_step: int, params: ReplayParams) -> bool:
     return encounter.end_step < last_step and _last_needed_step(encounter, params) <= last_step
 
 
+Pair = tuple[int, int]
+
+
+def _pair(encounter: Encounter) -> Pair:
+    a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
+    return a, b
+
+
+def _by_pair(encounters: Iterable[Encounter]) -> dict[Pair, list[Encounter]]:
+    found: dict[Pair, list[Encounter]] = {}
+    for encounter in encounters:
+        found.setdefault(_pair(encounter), []).append(encounter)
+    return found
+
+
+def _needs(
+    encounters: Sequence[Encounter],
+    core: tuple[int, int],
+    steps: tuple[int, int],
+    data_steps: tuple[int, int],
+    params: ReplayParams,
+) -> tuple[bool, bool]:
+    """Whether a search over ``steps`` leaves one pair's encounters in ``core`` unsettled
+    (``encounters``: all of the pair's in the search): (it needs steps before ``steps``, it
+    needs steps after them). ``data_steps`` are the first and last steps with data."""
+    chain_steps = params.encounters.chain_steps(params.step_s)
+    from_start, to_end = steps[0] <= data_steps[0], steps[1] > data_steps[1]
+    reaching = [e for e in encounters if e.start_step <= core[1] and e.end_step >= core[0]]
+
+    def whole(encounter: Encounter) -> bool:
+        return to_end or _whole(encounter, steps[1], params)
+
+    def may_split_in_core(encounter: Encounter) -> bool:
+        # its passing opened where the step after is in the core: a later firing in its run
+        # starts an encounter there
+        opened = encounter.opened_step
+        return opened is not None and core[0] - 1 <= opened < core[1]
+
+    later = any(
+        not whole(e) and (e.start_step >= core[0] or may_split_in_core(e)) for e in reaching
+    )
+    if from_start or all(e.chain_start_step - chain_steps >= steps[0] for e in reaching):
+        return False, later
+    # A passing open from before the window changes nothing in the core where the pair
+    # fires nowhere in the window (no trigger to split at, none to join) and its runs
+    # through the core end in it.
+    quiet = not any(e.triggered for e in encounters) and all(
+        to_end or e.end_step < steps[1] for e in reaching
+    )
+    return not quiet, later
+
+
+def _data_steps(job: SlabContext) -> tuple[int, int]:
+    """The first and last grid steps the decided reports reach (bounds for ``_needs``)."""
+    first_s = min((f.t_min_s for f in job.spill.files), default=job.data_end_s)
+    return math.floor(first_s / job.params.step_s), math.floor(job.data_end_s / job.params.step_s)
+
+
 def replay_slab(
     slab: int, job: SlabContext, evaluate: PairEvaluator, chart: Chart | None
 ) -> SlabResult:
     """Stage 2 for one slab (see the module docstring)."""
     params = job.params
     core = job.core_steps(slab)
-    last_data_step = math.floor(job.data_end_s / params.step_s)
-    # Before the core: the interaction is judged from before a trigger at the core's start.
-    lead = window_steps(params.interactions, params.step_s)
-    window = (core[0] - 1 - lead, core[1] + tail_steps(params))
+    data_steps = _data_steps(job)
+    window = (core[0] - lead_steps(params), core[1] + tail_steps(params))
     tracks = _tracks(job, window, None)
     own = job.own_mmsi or None
     search = find_encounters(tracks, params.encounters, own, counted_steps=core, require_own=False)
-    # Seats of encounters still going on at the window's end are followed, all together.
-    PairKey = tuple[int, int, int]
-    slots: list[tuple[Encounter, Tracks] | tuple[PairKey, tuple[int, int]]] = []
-    to_follow: dict[PairKey, Encounter] = {}
-    for encounter in search.encounters:
-        if not core[0] <= encounter.start_step <= core[1]:
-            continue
-        if _whole(encounter, window[1], params) or window[1] > last_data_step:
-            slots.append((encounter, tracks))
-            continue
-        a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
-        key = (encounter.start_step, a, b)
-        to_follow.setdefault(key, encounter)
-        slots.append((key, (encounter.own_mmsi, encounter.target_mmsi)))
-    followed = _follow(job, to_follow, window)
     owned: list[tuple[Encounter, Tracks]] = []
-    for first, second in slots:
-        if isinstance(first, Encounter):
-            owned.append((first, second))  # type: ignore[arg-type]
+    pending: dict[Pair, tuple[bool, bool]] = {}
+    for pair, mine in _by_pair(search.encounters).items():
+        needs = _needs(mine, core, window, data_steps, params)
+        if any(needs):
+            pending[pair] = needs
         else:
-            owned.append(followed[first][second])  # type: ignore[index]
+            owned.extend((e, tracks) for e in mine if core[0] <= e.start_step <= core[1])
+    settled = _settle(job, pending, core, window, data_steps)
+    followed = 0
+    for pair in pending:
+        owned.extend(settled[pair])
+        followed += any(
+            not _whole(e, window[1], params) and window[1] <= data_steps[1]
+            for e, _ in settled[pair]
+        )
+    owned.sort(key=lambda found: (found[0].start_step, found[0].own_mmsi, found[0].target_mmsi))
     encounters = tuple(e for e, _ in owned)
     by_id = {e.encounter_id: t for e, t in owned}
     pairs = []
@@ -436,9 +512,7 @@ def replay_slab(
         slab=slab,
         pairs=tuple(pairs),
         candidate_pair_steps=search.candidate_pair_steps,
-        candidate_pairs=frozenset(
-            (min(e.own_mmsi, e.target_mmsi), max(e.own_mmsi, e.target_mmsi)) for e in encounters
-        ),
+        candidate_pairs=frozenset(_pair(e) for e in encounters),
         encounters=len(encounters),
         triggered=sum(e.triggered for e in encounters),
         samples=int(
@@ -447,42 +521,44 @@ def replay_slab(
                 & (tracks.samples["sog_kn"] >= params.min_sog_kn)
             ).sum()
         ),
-        followed=len(to_follow),
+        followed=followed,
+        looked_back=sum(earlier for earlier, _ in pending.values()),
     )
 
 
-def _follow(
+def _settle(
     job: SlabContext,
-    encounters: dict[tuple[int, int, int], Encounter],
+    pending: dict[Pair, tuple[bool, bool]],
+    core: tuple[int, int],
     window: tuple[int, int],
-) -> dict[tuple[int, int, int], dict[tuple[int, int], tuple[Encounter, Tracks]]]:
-    """Each encounter (keyed by its start step and sorted MMSIs) as far as it goes, in each
-    of its seats: its vessels' samples in windows that double, until every seat is whole.
-    The pairs are followed together (one read and one search per window); an encounter is
-    a matter of its two vessels alone, so the others do not change it."""
+    data_steps: tuple[int, int],
+) -> dict[Pair, list[tuple[Encounter, Tracks]]]:
+    """The encounters starting in ``core`` of each pending pair (with what ``_needs`` found
+    missing in ``window``), searched again for their vessels alone in windows that double
+    before the core, after it, or both, until each pair is settled. The pairs are searched
+    together (one read and one search per window); a pair's encounters are a matter of its
+    two vessels alone, so the others do not change them."""
     params = job.params
-    last_data_step = math.floor(job.data_end_s / params.step_s)
-    reach = window[1] - window[0]
-    pending = dict(encounters)
-    found: dict[tuple[int, int, int], dict[tuple[int, int], tuple[Encounter, Tracks]]] = {}
-    while pending:
-        reach *= 2
-        steps = (window[0], window[0] + reach)
-        vessels = sorted({m for _, a, b in pending for m in (a, b)})
+    steps = window
+    needs = dict(pending)
+    found: dict[Pair, list[tuple[Encounter, Tracks]]] = {}
+    while needs:
+        if any(earlier for earlier, _ in needs.values()):
+            steps = (core[0] - 2 * (core[0] - steps[0]), steps[1])
+        if any(later for _, later in needs.values()):
+            steps = (steps[0], core[1] + 2 * (steps[1] - core[1]))
+        vessels = sorted({m for pair in needs for m in pair})
         own = [m for m in job.own_mmsi if m in vessels] if job.own_mmsi else None
         tracks = _tracks(job, steps, vessels)
-        search = find_encounters(tracks, params.encounters, own, require_own=False)
-        seats: dict[tuple[int, int, int], list[Encounter]] = {}
-        for encounter in search.encounters:
-            a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
-            key = (encounter.start_step, a, b)
-            if key in pending:
-                seats.setdefault(key, []).append(encounter)
-        for key in list(pending):
-            mine = seats.get(key, [])
-            if all(_whole(e, steps[1], params) for e in mine) or steps[1] > last_data_step:
-                found[key] = {(e.own_mmsi, e.target_mmsi): (e, tracks) for e in mine}
-                del pending[key]
+        search = _by_pair(
+            find_encounters(tracks, params.encounters, own, require_own=False).encounters
+        )
+        for pair in list(needs):
+            mine = search.get(pair, [])
+            needs[pair] = _needs(mine, core, steps, data_steps, params)
+            if not any(needs[pair]):
+                found[pair] = [(e, tracks) for e in mine if core[0] <= e.start_step <= core[1]]
+                del needs[pair]
     return found
 
 
@@ -494,8 +570,7 @@ def triggered_pairs(
     for encounter in encounters:
         if not encounter.triggered:
             continue
-        a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
-        seats.setdefault((encounter.start_step, a, b), []).append(encounter)
+        seats.setdefault((encounter.start_step, *_pair(encounter)), []).append(encounter)
     return [
         (found[0], tuple(sorted(e.own_mmsi for e in found))) for _, found in sorted(seats.items())
     ]

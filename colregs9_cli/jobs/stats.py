@@ -70,7 +70,8 @@ def run_stats(
         from ..outputs import check_out_dir
 
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
-        check_out_dir(target, overwrite, inputs=[*paths, *([query_path] if query_path else [])])
+        given = [*paths, *([query_path] if query_path else [])]
+        check_out_dir(target, overwrite, inputs=given, command="stats")
         from ..ais.load import count_ais
         from ..core.dimensions import GroupBy, Per, dimension_stats
         from ..provenance import inputs_manifest
@@ -92,7 +93,7 @@ def run_stats(
         ledger=data.ledger.to_dict(),
     )
     manifest = build_manifest(result, query, read)
-    files = write_stats_reports(target, result, query.name, manifest)
+    files = write_stats_reports(target, result, query.name, manifest, overwrite)
     return StatsRun(
         result=result,
         text=format_text(result, query.name),

@@ -42,19 +42,20 @@ def format_swing_table(table: pd.DataFrame) -> str:
 
 def run_swing(out_dir: Path | None = None, overwrite: bool = False) -> SwingReport:
     """Write rate_of_swing.csv, rate_of_swing.png and run.json to ``out_dir`` (default
-    reports/swing/), which is replaced whole as ``stats`` and ``replay`` replace theirs.
+    reports/swing/), which is replaced as ``stats`` and ``replay`` replace theirs.
 
-    Errors: an ``out_dir`` that cannot take a report, or holds something other than a colregs9
-    report and ``overwrite`` is false (``OutputError``, exit 2), before any work.
+    Errors: an ``out_dir`` that cannot take a report, or, unless ``overwrite``, holds a report
+    of another command or files colregs9 did not write (``OutputError``, exit 2), before any
+    work (``outputs.check_out_dir``).
     """
     out_dir = DEFAULT_OUT_DIR if out_dir is None else Path(out_dir)
-    check_out_dir(out_dir, overwrite)
+    check_out_dir(out_dir, overwrite, command="swing")
     table = reference_vessels()
     defaults = ManoeuvrabilityParams()
     # run.json marks the directory as a colregs9 report, which a rerun may then replace.
     manifest = {**run_header("swing"), "fixed_swing_deg_per_m": defaults.swing_deg_per_m}
     figure = rate_of_swing_figure(table, defaults.swing_deg_per_m)
-    with report_directory(out_dir) as staging:
+    with report_directory(out_dir, overwrite) as staging:
         write_csv(staging / CSV_NAME, table)
         save_figure(staging / PNG_NAME, figure, dpi=150)
         write_json(staging / REPORT_MARKER, manifest)

@@ -40,8 +40,8 @@ img.figure { max-width: 100%; border: 1px solid #ddd; }
 """
 
 # Sorts a table by a clicked header (numbers as numbers), filters its rows by the text box
-# and the selects (a link to #pair-N sets the pair select), and marks figures that did not
-# load.
+# and the selects (a link to #pair-N sets the pair select), and marks a figure that fails
+# to load.
 _SCRIPT = r"""
 function cellValue(row, index) {
   const text = row.cells[index].dataset.value ?? row.cells[index].textContent;
@@ -103,16 +103,17 @@ function selectPair() {
   table.scrollIntoView();
 }
 window.addEventListener("hashchange", selectPair);
-window.addEventListener("load", () => {
-  document.querySelectorAll("img.figure").forEach(img => {
-    if (!img.complete || img.naturalWidth === 0) {
-      const note = document.createElement("p");
-      note.className = "missing";
-      note.textContent = "figure not found: " + img.getAttribute("src");
-      img.replaceWith(note);
-    }
-  });
-});
+// A figure is marked missing on its own error event, never by a check at "load": a lazy
+// figure below the fold has not loaded yet then, and loads when it is scrolled to. The
+// listener captures on the document from the head, before any image can fail.
+document.addEventListener("error", event => {
+  const img = event.target;
+  if (!(img instanceof HTMLImageElement) || !img.classList.contains("figure")) return;
+  const note = document.createElement("p");
+  note.className = "missing";
+  note.textContent = "figure not found: " + img.getAttribute("src");
+  img.replaceWith(note);
+}, true);
 """
 
 

@@ -305,6 +305,7 @@ def replay_html(
         body.append(f'<section class="encounter" id="enc-{html.escape(identifier)}">')
         body.append(f"<h3>{html.escape(identifier)}</h3>")
         if plots:
+            # Lazy: a report of hundreds of figures loads each as it is scrolled to.
             body.append(
                 f'<img class="figure" src="{encounter_dir}/{html.escape(identifier)}.png" '
                 f'alt="figure of {html.escape(identifier)}" loading="lazy">'

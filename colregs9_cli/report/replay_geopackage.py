@@ -93,10 +93,11 @@ def _fields(table: pd.DataFrame) -> _Fields:
 
 def _dtype(annotation: Any) -> str:
     """The pandas dtype of an ``EncounterSummary`` field (``X | None`` as X, nullable)."""
-    if isinstance(annotation, types.UnionType):
+    optional = isinstance(annotation, types.UnionType)
+    if optional:
         annotation = next(a for a in typing.get_args(annotation) if a is not type(None))
     if annotation is bool:
-        return "bool"
+        return "boolean" if optional else "bool"  # empty stays empty, never false
     if annotation is int:
         return "Int64"
     if annotation is float:

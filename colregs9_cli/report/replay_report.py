@@ -157,11 +157,11 @@ def format_summary(result: ReplayResult) -> str:
     if result.pairs:
         lines.append(f"{result.interaction_summary}; only encounters get a verdict.")
     if not result.pairs:
+        # No word of files: the API writes none, and the CLI says where its report went.
         lines.append(
             "No triggered encounters: no pair came within "
             f"CPA < {result.params.encounters.cpa_req_m:g} m with 0 <= TCPA <= "
-            f"{result.params.encounters.tcpa_act_s:g} s. pairs.csv and encounters.csv have a "
-            "header only."
+            f"{result.params.encounters.tcpa_act_s:g} s."
         )
         return "\n".join(lines) + "\n"
     rows = [list(SUMMARY_HEADER)]
@@ -578,6 +578,10 @@ class EncounterParts(Protocol):
         """Start ``function`` on each part's encounters, in order; the returned callables
         wait for the parts' results."""
 
+    def settle(self) -> None:
+        """After a failure: return once no task started here writes any more (those not
+        begun are dropped), so that the report's staging directory can go."""
+
 
 @dataclasses.dataclass(frozen=True)
 class EncountersHere:
@@ -590,6 +594,9 @@ class EncountersHere:
     ) -> list[Callable[[], Part]]:
         result = function(self.encounters)
         return [lambda: result]
+
+    def settle(self) -> None:
+        """Nothing runs elsewhere."""
 
 
 def series_path(series_dir: Path, outcome: EncounterOutcome) -> Path:
@@ -611,21 +618,20 @@ def write_replay_reports(
     progress: ProgressSink,
     drawer: Drawer = draw_here,
     parts: EncounterParts | None = None,
+    overwrite: bool = False,
 ) -> tuple[Path, ...]:
-    """Write every report file into ``result.out_dir``, which is replaced whole (no file of
-    an earlier run stays); returns the paths written. ``drawer`` draws the figures (here, or
-    on the workers of a cluster: ``dask_run.dask_drawer``); ``parts``: where the encounters'
-    series CSVs and map layers are made (default: here)."""
-    with report_directory(result.out_dir) as staging:
-        written = _write_replay_files(
-            result,
-            staging,
-            chart,
-            plots,
-            progress,
-            drawer,
-            parts if parts is not None else EncountersHere(result.encounters),
-        )
+    """Write every report file into ``result.out_dir``, which is replaced (no file of an
+    earlier run stays; files colregs9 did not write stay: ``outputs.report_directory``, with
+    ``overwrite``); returns the paths written. ``drawer`` draws the figures (here, or on the
+    workers of a cluster: ``dask_run.dask_drawer``); ``parts``: where the encounters' series
+    CSVs and map layers are made (default: here)."""
+    parts = parts if parts is not None else EncountersHere(result.encounters)
+    with report_directory(result.out_dir, overwrite) as staging:
+        try:
+            written = _write_replay_files(result, staging, chart, plots, progress, drawer, parts)
+        except BaseException:
+            parts.settle()  # no late file in the staging directory once it is removed
+            raise
     return tuple(result.out_dir / path.relative_to(staging) for path in written)
 
 

@@ -243,12 +243,16 @@ def build_manifest(result: StatsResult, query: Query, read: StatsInputs) -> dict
 
 
 def write_stats_reports(
-    out_dir: Path, result: StatsResult, query_name: str, manifest: dict[str, Any]
+    out_dir: Path,
+    result: StatsResult,
+    query_name: str,
+    manifest: dict[str, Any],
+    overwrite: bool = False,
 ) -> tuple[Path, ...]:
-    """Write the five report files into ``out_dir``, which is replaced whole; returns their
-    paths."""
+    """Write the five report files into ``out_dir``, which is replaced (files colregs9 did
+    not write stay: ``outputs.report_directory``, with ``overwrite``); returns their paths."""
     names = (CSV_NAME, MARKDOWN_NAME, HISTOGRAM_NAME, HTML_NAME, MANIFEST_NAME)
-    with report_directory(out_dir) as staging:
+    with report_directory(out_dir, overwrite) as staging:
         csv_path, markdown_path, histogram_path, html_path, manifest_path = (
             staging / n for n in names
         )
