@@ -211,7 +211,7 @@ def test_a_failed_swap_puts_the_users_files_back(
 _NAMES = st.sampled_from(["a.csv", "b.png", "notes.txt", "x.qgz", "sub/c.csv", "sub/d.txt", "e"])
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=25, deadline=None)
 @given(
     old=st.sets(_NAMES, max_size=5),
     new=st.sets(_NAMES, max_size=5),

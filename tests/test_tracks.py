@@ -600,7 +600,7 @@ def _claims(draw) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=40, deadline=None)
 @given(reports_table=_claims(), slab_s=st.sampled_from([5.0, 20.0, 60.0, 300.0, 1000.0]))
 def test_sog_checks_in_slabs_are_those_of_one_go(reports_table, slab_s) -> None:
     """Reports held past their slab for their next neighbour: the same SOGs nulled and the
