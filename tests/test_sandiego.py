@@ -161,3 +161,15 @@ def test_a_chart_far_from_the_ais_is_left_out_and_changes_nothing(
     pd.testing.assert_frame_equal(
         _table(both, "encounters.csv"), _table(sandiego, "encounters.csv")
     )
+
+
+def test_tradition_and_champagne_come_within_a_hundred_metres(sandiego) -> None:
+    """They turned away at 1,068 m (TCPA negative: the old pass), then closed to about 97 m
+    at about 00:19:12 in their raw reports: the passing runs to the real closest approach."""
+    pairs = _table(sandiego, "pairs.csv").set_index(["mmsi_a", "mmsi_b"])
+    pair = pairs.loc[("338403914", "367412850")]
+    assert pair["interaction"] == "encounter" and pair["data_covers_cpa"] == "true"
+    antenna_m = float(pair["actual_min_separation_m"])
+    assert 90.0 < antenna_m < 105.0
+    assert pair["actual_min_separation_utc"].startswith("2022-01-03T00:19:")
+    assert float(pair["actual_min_separation_hull_m"]) <= antenna_m
