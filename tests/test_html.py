@@ -27,15 +27,24 @@ from urllib.request import url2pathname
 import pytest
 
 from colregs9_cli.charts.water import load_chart
+from colregs9_cli.core.colregs import Role
 from colregs9_cli.core.rows import situation_or_interaction
 from colregs9_cli.jobs.demo import run_demo
 from colregs9_cli.jobs.stats import run_stats
 from colregs9_cli.progress import progress_bar
-from colregs9_cli.report.html_report import ENCOUNTER_TABLE_COLUMNS, pair_numbers
+from colregs9_cli.report.html_report import (
+    ENCOUNTER_TABLE_COLUMNS,
+    KEY_COLUMNS,
+    MORE_COLUMNS,
+    _encounter_row,
+    page_title,
+    pair_numbers,
+    time_span,
+)
 from colregs9_cli.report.replay_report import ENCOUNTER_DIR, write_replay_reports
 from colregs9_cli.report.stats_report import HISTOGRAM_NAME
 
-from fixture_files import DMA26, SANDIEGO_ENC
+from fixture_files import DMA26, SANDIEGO_AIS, SANDIEGO_ENC
 
 if TYPE_CHECKING:
     from playwright.sync_api import Browser, Page, ViewportSize
@@ -443,3 +452,98 @@ def test_without_chromium_a_browser_test_skips_with_the_reason(required: bool) -
     else:
         assert run.returncode == 0 and "1 skipped" in run.stdout, run.stdout
         assert "apt-get install chromium" in run.stdout
+
+
+# The encounter table's geometry: each header's box, and whether it is shown at all.
+_HEADERS = """() => Array.from(document.querySelectorAll("#encounters th")).map(h => {
+  const box = h.getBoundingClientRect();
+  return {text: h.textContent, left: box.left, right: box.right, width: box.width,
+          shown: h.checkVisibility()};
+})"""
+
+
+def test_the_table_fits_the_window_with_its_key_columns(browser, sandiego_report) -> None:
+    """At 1400 × 1000 the key columns are all in the window and the table no wider than it;
+    ticking "more columns" shows the others, and their cells."""
+    _, out = sandiego_report
+    page, log = open_page(browser, out / "index.html")
+    width = VIEWPORT["width"]
+    table = page.locator("#encounters").bounding_box()
+    assert table is not None and table["x"] >= 0 and table["x"] + table["width"] <= width
+    assert page.evaluate("document.documentElement.scrollWidth") <= width
+    headers = page.evaluate(_HEADERS)
+    assert [h["text"] for h in headers] == list(ENCOUNTER_TABLE_COLUMNS)
+    key = [h for h in headers if h["text"] in KEY_COLUMNS]
+    assert [h["text"] for h in key] == list(KEY_COLUMNS)
+    assert all(h["shown"] and h["left"] >= 0 and h["right"] <= width for h in key), key
+    assert not any(h["shown"] for h in headers if h["text"] in MORE_COLUMNS)
+    # The key columns include what the issue found off-screen: least separation and acted.
+    assert {"min sep (m)", "give-way acted", "give-way", "deciding rule"} <= set(KEY_COLUMNS)
+    cpa = ENCOUNTER_TABLE_COLUMNS.index("CPA (m)")
+    first_cpa = page.locator("#encounters tbody tr").first.locator("td").nth(cpa)
+    assert not first_cpa.is_visible()
+    page.locator("#encounters-more").check()
+    headers = page.evaluate(_HEADERS)
+    assert all(h["shown"] and h["width"] > 0 for h in headers), headers
+    assert first_cpa.is_visible()
+    page.locator("#encounters-more").uncheck()
+    assert not first_cpa.is_visible()
+    assert log["errors"] == []
+    page.context.close()
+
+
+def test_the_give_way_column_names_the_final_give_way_vessels(sandiego_report) -> None:
+    result, _ = sandiego_report
+    numbers = pair_numbers(result)
+    for outcome in result.encounters:
+        s = outcome.summary
+        cells = _encounter_row(outcome, numbers)
+        row = dict(zip(ENCOUNTER_TABLE_COLUMNS, cells, strict=True))
+        cell = row["give-way"]
+        if s.own_role_final is None:
+            assert cell == ""
+            continue
+        for mmsi, role in ((s.own_mmsi, s.own_role_final), (s.target_mmsi, s.target_role_final)):
+            assert (f"({mmsi})" in cell or cell.split(", ").count(str(mmsi)) == 1) == (
+                role is Role.GIVE_WAY
+            ), (cell, s.own_role_final, s.target_role_final)
+        if Role.GIVE_WAY not in (s.own_role_final, s.target_role_final):
+            assert cell == "none"
+
+
+def test_the_title_names_the_input_time_span_query_and_chart(browser, sandiego_report) -> None:
+    result, out = sandiego_report
+    triggers = [o.summary.trigger_utc for o in result.encounters]
+    first, last = min(triggers), max(triggers)
+    span = f"{first:%Y-%m-%d %H:%M:%S} – {last:%H:%M:%S} UTC"
+    page, log = open_page(browser, out / "index.html")
+    title = page.title()
+    assert title == page.locator("h1").inner_text()
+    assert title == (
+        f"Replay of {SANDIEGO_AIS.name}, {span}, query {result.query_name}, "
+        f"chart {SANDIEGO_ENC.name}"
+    )
+    line = page.locator("p.inputs").inner_text()
+    assert line.startswith(f"Input: {SANDIEGO_AIS.name}. Time span: {span} (first to last")
+    assert f"Query: {result.query_name} (" in line and f"Chart: {SANDIEGO_ENC.name}." in line
+    # File names only: the directories the run read from are run.json's.
+    assert str(SANDIEGO_AIS.parent) not in page.content()
+    assert log["errors"] == []
+    page.context.close()
+
+
+def test_the_time_span_is_the_query_window_when_it_has_one(sandiego_report) -> None:
+    result, _ = sandiego_report
+    query = {**result.manifest["query"], "time": {"start": "2022-01-03T00:00:00Z", "end": None}}
+    half_open = dataclasses.replace(result, manifest={**result.manifest, "query": query})
+    assert time_span(half_open) == time_span(result)
+    triggers = time_span(result)
+    assert triggers is not None and triggers[1] == "first to last trigger"
+    query["time"] = {"start": "2022-01-03T00:00:00Z", "end": "2022-01-04T00:25:00Z"}
+    assert time_span(half_open) == (
+        "2022-01-03 00:00:00 – 2022-01-04 00:25:00 UTC",
+        "query window",
+    )
+    bare = dataclasses.replace(result, pairs=(), manifest={})
+    assert time_span(bare) is None
+    assert page_title(bare) == f"Replay, query {result.query_name}"

@@ -3,17 +3,19 @@
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 import pandas as pd
 import pytest
 from test_encounters import FRAME, straight_track, tracks_of
 
 from colregs9_cli.core.colregs import ColregsParams, Role, Situation
-from colregs9_cli.core.encounters import find_encounters
+from colregs9_cli.core.encounters import Encounter, find_encounters
 from colregs9_cli.core.manoeuvrability import ManoeuvrabilityParams
 from colregs9_cli.core.pair import evaluate_pair
 from colregs9_cli.core.replay_results import pair_outcome
 from colregs9_cli.core.rows import seat_series
+from colregs9_cli.core.tracks import Tracks
 from colregs9_cli.jobs.replay_params import ReplayParams, ReplayRunParams
 
 PARAMS = ReplayRunParams(ReplayParams(), ColregsParams(), ManoeuvrabilityParams(), ())
@@ -68,3 +70,55 @@ def test_both_seats_rows_and_series_mirror_each_other(crossing) -> None:
     pd.testing.assert_series_equal(
         series[0]["own_role_final"], series[1]["target_role_final"], check_names=False
     )
+
+
+def _crossing_reports(kept: Callable[[pd.Series], pd.Series]) -> tuple[Tracks, Encounter]:
+    """The crossing above with a 100 m length reported by both, keeping the reports at the
+    times ``kept`` chooses: both reach the origin at 400 s."""
+    frames = [
+        straight_track(1, -2000.0, 0.0, 0.0, 5.0, 800),
+        straight_track(2, 0.0, 2000.0, 270.0, 5.0, 800),
+    ]
+    for frame in frames:
+        frame["length_m"] = 100.0
+    seconds = pd.concat(frames)["timestamp"].sub(pd.Timestamp("2024-01-01T12:00:00Z"))
+    both = pd.concat(frames)[kept(seconds.dt.total_seconds()).to_numpy()]
+    tracks = tracks_of(both.reset_index(drop=True))
+    (encounter,) = find_encounters(tracks, PARAMS.replay.encounters, own_mmsi=[2]).triggered
+    return tracks, encounter
+
+
+def test_a_least_separation_across_a_long_report_gap_is_flagged() -> None:
+    # No reports between 300 s and 500 s: the tracks are interpolated straight to a 0 m
+    # "collision" at 400 s, while the real fixes never came closer than at 300 s or 500 s,
+    # 500 m from the origin each: √2 · 500 = 707.1 m. 200 s at 5 m/s is 1,000 m > 100 m.
+    tracks, encounter = _crossing_reports(lambda t: (t <= 300) | (t >= 500))
+    audit = evaluate_pair(tracks, encounter, None, PARAMS.pair).audit
+    assert audit.min_separation_m == pytest.approx(0.0, abs=1.0)
+    assert audit.min_separation_report_gap_s == pytest.approx(200.0)
+    assert audit.min_separation_at_fixes_m == pytest.approx(707.1, abs=0.5)
+    assert audit.min_separation_interpolated is True
+
+
+def test_a_least_separation_between_dense_reports_is_observed() -> None:
+    # Reports every 10 s, one at 400 s: the least separation is at a fix; 10 s at 5 m/s is
+    # 50 m, half her length.
+    tracks, encounter = _crossing_reports(lambda t: t >= 0)
+    pair = evaluate_pair(tracks, encounter, None, PARAMS.pair)
+    audit = pair.audit
+    assert audit.min_separation_report_gap_s == 0.0
+    assert audit.min_separation_at_fixes_m == pytest.approx(audit.min_separation_m, abs=1e-6)
+    assert audit.min_separation_interpolated is False
+    summary = pair_outcome(pair, (1, 2), FRAME).seats[0].summary
+    assert summary.min_separation_interpolated is False
+    assert summary.min_separation_report_gap_s == 0.0
+
+
+def test_a_short_gap_through_the_minimum_is_flagged_when_she_outruns_her_length() -> None:
+    # Reports every 10 s except 390 s and 400 s: at 400 s both are 20 s into a 30 s gap; 30 s
+    # at 5 m/s is 150 m > 100 m, flagged; the fixes at 380 s and 410 s are 100 m and 50 m out.
+    tracks, encounter = _crossing_reports(lambda t: (t != 390) & (t != 400))
+    audit = evaluate_pair(tracks, encounter, None, PARAMS.pair).audit
+    assert audit.min_separation_report_gap_s == pytest.approx(30.0)
+    assert audit.min_separation_at_fixes_m == pytest.approx(50.0 * 2**0.5, abs=0.5)
+    assert audit.min_separation_interpolated is True

@@ -8,7 +8,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from colregs9_cli.core.passing import PassingParams, horizon_steps, passing
+from colregs9_cli.core.passing import PassingParams, horizon_steps, minimum_evidence, passing
 
 PARAMS = PassingParams()
 
@@ -67,3 +67,24 @@ def test_the_pass_is_the_first_clear_opening_and_its_least_range(ranges: list[fl
     if seen.covers_cpa:
         least = values[: seen.end_row + 1].min()
         assert values[seen.end_row] > least + max(PARAMS.open_m, PARAMS.open_frac * least)
+
+
+@given(
+    st.lists(st.floats(0.0, 5000.0), min_size=1, max_size=40),
+    st.lists(st.sampled_from([0.0, 0.5, 3.0, 60.0]), min_size=80, max_size=80),
+)
+def test_the_least_range_at_fixes_is_never_below_the_least_range(
+    ranges: list[float], nearest: list[float]
+) -> None:
+    n = len(ranges)
+    seen = passing(ranges, PassingParams())
+    near = np.reshape(nearest[: 2 * n], (n, 2))
+    evidence = minimum_evidence(
+        ranges, near * 2, near, np.full((n, 2), 5.0), (100.0, 100.0), seen, 1.0
+    )
+    assert evidence is not None and seen.min_separation_m is not None
+    if evidence.at_fixes_m is not None:
+        assert evidence.at_fixes_m >= seen.min_separation_m
+    at_cpa = near[seen.cpa_row]
+    assert evidence.report_gap_s == 2 * at_cpa.max()
+    assert evidence.interpolated == bool((2 * at_cpa * 5.0 > 100.0).any())

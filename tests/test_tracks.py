@@ -208,6 +208,36 @@ def test_sub_second_report_times_stay_inside_the_segment() -> None:
     assert samples["north_m"].tolist() == pytest.approx([6.0, 16.0, 26.0])
 
 
+def test_samples_carry_the_report_gap_they_were_interpolated_across() -> None:
+    # Reports at T0+2, 5 and 23 s on a 1 s grid: samples at 3-4 s lie in a 3 s gap, 6-22 s
+    # in an 18 s gap; the samples at a report's own second are that report.
+    samples = build_tracks(
+        reports([2, 5, 23], [0.0, 30.0, 210.0], [0.0] * 3), FRAME, TrackParams()
+    ).samples
+    gap = dict(zip(samples["t_s"] - T0_S, samples["report_gap_s"], strict=True))
+    nearest = dict(zip(samples["t_s"] - T0_S, samples["nearest_report_s"], strict=True))
+    assert [gap[t] for t in (2.0, 3.0, 4.0, 5.0, 6.0, 14.0, 22.0, 23.0)] == [
+        0.0,
+        3.0,
+        3.0,
+        0.0,
+        18.0,
+        18.0,
+        18.0,
+        0.0,
+    ]
+    assert [nearest[t] for t in (3.0, 4.0, 6.0, 14.0, 22.0)] == [1.0, 1.0, 1.0, 9.0, 1.0]
+    assert nearest[2.0] == nearest[5.0] == nearest[23.0] == 0.0
+
+
+def test_a_sample_between_sub_second_reports_is_not_at_a_report() -> None:
+    samples = build_tracks(
+        reports([0.4, 3.6], [0.0, 32.0], [0.0, 0.0]), FRAME, TrackParams()
+    ).samples
+    assert samples["report_gap_s"].tolist() == pytest.approx([3.2] * 3)
+    assert samples["nearest_report_s"].tolist() == pytest.approx([0.6, 1.6, 0.6])
+
+
 def test_segment_between_grid_points_has_no_samples() -> None:
     frame = reports([1, 3], [0.0, 10.0], [0.0, 0.0])
     tracks = build_tracks(frame, FRAME, TrackParams(step_s=5.0))

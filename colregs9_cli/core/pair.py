@@ -68,7 +68,7 @@ from .manoeuvrability import (
     assess_manoeuvrability,
     unplaced_assessment,
 )
-from .passing import Passing, PassingParams, horizon_steps, passing
+from .passing import Passing, PassingParams, horizon_steps, minimum_evidence, passing
 from .rule9 import Finding, PairVerdict, Rule9Assessment, Rule9Params, decide_pair
 from .rule9 import nav_status_finding as _finding
 from .tracks import ANTENNA_OFFSET_COLUMNS, Tracks
@@ -146,6 +146,10 @@ class PairAudit:
     # Either hull's antenna placed by assumption, not by her AIS A, B, C, D (None: no hull
     # distance).
     hull_antenna_position_assumed: bool | None = None
+    # What the least separation rests on (passing.MinimumEvidence; None: no least separation).
+    min_separation_report_gap_s: float | None = None
+    min_separation_at_fixes_m: float | None = None
+    min_separation_interpolated: bool | None = None
 
 
 def hull_offsets(dimensions: VesselDimensions, static: dict[str, Any]) -> HullOffsets:
@@ -566,6 +570,7 @@ def _audit(
     window: pd.DataFrame,
     seen: Passing,
     hulls: tuple[HullOffsets, HullOffsets],
+    lengths_m: tuple[float, float],
     params: ConductParams,
     step_s: float,
 ) -> PairAudit:
@@ -573,7 +578,39 @@ def _audit(
         return PairAudit(
             False, None, None, (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT), (None, None)
         )
-    cpa_utc = window["timestamp"].iloc[seen.cpa_row]
+    audit = _audit_conduct(window, seen, seen.cpa_row, hulls, params, step_s)
+
+    def both(name: str) -> np.ndarray:
+        return window[[f"{prefix}{name}" for prefix in PREFIXES]].to_numpy(dtype=float)
+
+    evidence = minimum_evidence(
+        window["range_m"].to_numpy(dtype=float),
+        both("report_gap_s"),
+        both("nearest_report_s"),
+        both("speed_mps"),
+        lengths_m,
+        seen,
+        step_s,
+    )
+    if evidence is None:
+        return audit
+    return dataclasses.replace(
+        audit,
+        min_separation_report_gap_s=evidence.report_gap_s,
+        min_separation_at_fixes_m=evidence.at_fixes_m,
+        min_separation_interpolated=evidence.interpolated,
+    )
+
+
+def _audit_conduct(
+    window: pd.DataFrame,
+    seen: Passing,
+    cpa_row: int,
+    hulls: tuple[HullOffsets, HullOffsets],
+    params: ConductParams,
+    step_s: float,
+) -> PairAudit:
+    cpa_utc = window["timestamp"].iloc[cpa_row]
     hull_m = least_hull_separation_m(window.iloc[: seen.end_row + 1], hulls)
     assumed = None if hull_m is None else any(h.defaulted for h in hulls)
     if not seen.covers_cpa:
@@ -588,7 +625,7 @@ def _audit(
             hull_m,
             assumed,
         )
-    until = window.iloc[: seen.cpa_row + 1]
+    until = window.iloc[: cpa_row + 1]
     conducts = tuple(
         conduct(
             until[f"{prefix}course_deg"].to_numpy(dtype=float),
@@ -598,7 +635,7 @@ def _audit(
         for prefix in PREFIXES
     )
     before = tuple(
-        None if c.action_row is None else (seen.cpa_row - c.action_row) * step_s for c in conducts
+        None if c.action_row is None else (cpa_row - c.action_row) * step_s for c in conducts
     )
     return PairAudit(
         covers_cpa=True,
@@ -645,7 +682,8 @@ def evaluate_pair(
         hull_offsets(dimensions[0], _static(tracks.vessels, a)),
         hull_offsets(dimensions[1], _static(tracks.vessels, b)),
     )
-    audit = _audit(window, seen, hulls, params.conduct, step_s)
+    lengths_m = (dimensions[0].length_m, dimensions[1].length_m)
+    audit = _audit(window, seen, hulls, lengths_m, params.conduct, step_s)
     interaction = _interaction(tracks, oriented, encounter.trigger_step, params.interactions)
     steps = _pair_steps(series, dimensions, claims, chart, params, step_s)
     trigger = series.iloc[0]

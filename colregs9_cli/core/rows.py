@@ -80,6 +80,9 @@ class PairSummary:
     actual_min_separation_utc: pd.Timestamp | None
     actual_min_separation_hull_m: float | None
     hull_antenna_position_assumed: bool | None
+    min_separation_report_gap_s: float | None
+    min_separation_at_fixes_m: float | None
+    min_separation_interpolated: bool | None
     give_way_vessel_acted: Fact | None
     give_way_action: str | None
     give_way_action_as_rule_asks: Fact | None
@@ -192,6 +195,9 @@ class EncounterSummary:
     actual_min_separation_utc: pd.Timestamp | None
     actual_min_separation_hull_m: float | None
     hull_antenna_position_assumed: bool | None
+    min_separation_report_gap_s: float | None
+    min_separation_at_fixes_m: float | None
+    min_separation_interpolated: bool | None
     give_way_vessel_acted: Fact | None
     give_way_action: str | None
     give_way_action_as_rule_asks: Fact | None
@@ -397,6 +403,9 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         actual_min_separation_utc=pair.audit.cpa_utc,
         actual_min_separation_hull_m=pair.audit.min_hull_separation_m,
         hull_antenna_position_assumed=pair.audit.hull_antenna_position_assumed,
+        min_separation_report_gap_s=pair.audit.min_separation_report_gap_s,
+        min_separation_at_fixes_m=pair.audit.min_separation_at_fixes_m,
+        min_separation_interpolated=pair.audit.min_separation_interpolated,
         give_way_vessel_acted=all_of(v.conduct.changed for v in give_way) if give_way else None,
         give_way_action=_joined([v.conduct.action.value for v in give_way]),
         give_way_action_as_rule_asks=pair.give_way_action_as_rule_asks,
@@ -487,6 +496,9 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         actual_min_separation_utc=pair.actual_min_separation_utc,
         actual_min_separation_hull_m=pair.actual_min_separation_hull_m,
         hull_antenna_position_assumed=pair.hull_antenna_position_assumed,
+        min_separation_report_gap_s=pair.min_separation_report_gap_s,
+        min_separation_at_fixes_m=pair.min_separation_at_fixes_m,
+        min_separation_interpolated=pair.min_separation_interpolated,
         give_way_vessel_acted=pair.give_way_vessel_acted,
         give_way_action=pair.give_way_action,
         give_way_action_as_rule_asks=pair.give_way_action_as_rule_asks,

@@ -33,7 +33,10 @@ The rules, in order, per MMSI with reports sorted by time:
    (Unix epoch), at the grid times inside ``[first report, last report]``: nothing is
    extrapolated. North/east and SOG are linear in time; COG, heading and course are
    interpolated along the shorter arc (359° → 1° passes 0°, never 180°); the navigational
-   status is the latest report's (held, not interpolated).
+   status is the latest report's (held, not interpolated). Each sample carries
+   ``report_gap_s``, the time between the two reports that bracket it (0 at a report's own
+   time), and ``nearest_report_s``, the time to the nearer of them: a position interpolated
+   across a long gap is an estimate, not an observation (a river bend crossed by a 195 s gap).
 
 The course used for bearings (``course_deg``) is COG or heading (``CourseSource``); velocity
 always comes from COG and SOG, the motion over ground.
@@ -126,6 +129,8 @@ STATE_COLUMNS: tuple[str, ...] = (
     "sog_kn",
     "speed_mps",
     "nav_status",
+    "report_gap_s",
+    "nearest_report_s",
 )
 SAMPLE_COLUMNS: tuple[str, ...] = ("mmsi", "segment_id", "step", "t_s", "timestamp", *STATE_COLUMNS)
 
@@ -680,6 +685,11 @@ def _resample(
         data[name] = blend(values[left], values[right] - values[left])
     for name, values in circular.items():
         data[name] = wrap_deg(blend(values[left], signed_angle_deg(values[right] - values[left])))
+    # At a report's own time (weight 0) the sample is that report, whatever the next one.
+    data["report_gap_s"] = np.where(weight > 0.0, dt, 0.0)
+    data["nearest_report_s"] = np.where(
+        weight > 0.0, np.minimum(grid_t - t[left], t[right] - grid_t), 0.0
+    )
     status_index = np.where(weight == 1.0, right, left)
     data["nav_status"] = pd.array(nav_status[status_index], dtype="Int64")
     return pd.DataFrame(data)

@@ -30,6 +30,10 @@ th { background: #eef; cursor: pointer; position: sticky; top: 0; }
 th.sorted-asc::after { content: " ▲"; } th.sorted-desc::after { content: " ▼"; }
 td.num { text-align: right; }
 tr.hidden { display: none; }
+table.key-only .more { display: none; }
+/* Key columns only, long names wrap rather than push the table past the window. */
+table.key-only td { white-space: normal; }
+p.inputs { margin: 0.3em 0 0.8em; }
 .filters { margin: 0.8em 0; } .filters input { width: 22em; }
 section.encounter { border-top: 1px solid #ccc; padding-top: 0.5em; }
 dl.facts { display: grid; grid-template-columns: max-content auto; gap: 2px 12px; }
@@ -40,8 +44,9 @@ img.figure { max-width: 100%; border: 1px solid #ddd; }
 """
 
 # Sorts a table by a clicked header (numbers as numbers), filters its rows by the text box
-# and the selects (a link to #pair-N sets the pair select), and marks a figure that fails
-# to load.
+# and the selects (a link to #pair-N sets the pair select), shows a table's extra columns
+# (from a "more columns" box's data-from on) only while the box is ticked, and marks a
+# figure that fails to load.
 _SCRIPT = r"""
 function cellValue(row, index) {
   const text = row.cells[index].dataset.value ?? row.cells[index].textContent;
@@ -86,10 +91,19 @@ document.addEventListener("DOMContentLoaded", () => {
     if (box) box.addEventListener("input", () => applyFilters(table));
     document.querySelectorAll("select[data-table='" + table.id + "']").forEach(s =>
       s.addEventListener("change", () => applyFilters(table)));
-    // A link can carry a filter and a sort (a column number): index.html?q=head-on&sort=10
+    // A link can carry a filter and a sort (a column number): index.html?q=head-on&sort=5
     const query = new URLSearchParams(location.search);
     if (box && query.has("q")) { box.value = query.get("q"); applyFilters(table); }
     if (query.has("sort")) sortBy(table.tHead.rows[0].cells[Number(query.get("sort"))]);
+  });
+  document.querySelectorAll("input.more-columns").forEach(box => {
+    const table = document.getElementById(box.dataset.table);
+    const from = Number(box.dataset.from);
+    for (const row of table.rows)
+      Array.from(row.cells).slice(from).forEach(cell => cell.classList.add("more"));
+    const show = () => table.classList.toggle("key-only", !box.checked);
+    box.addEventListener("change", show);
+    show();
   });
   selectPair();
 });

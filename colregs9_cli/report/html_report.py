@@ -11,46 +11,56 @@ from __future__ import annotations
 import html
 import io
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import numpy as np
+import pandas as pd
 from matplotlib.figure import Figure
 
+from ..core.colregs import Role
 from ..core.replay_results import EncounterOutcome, ReplayResult
-from ..core.rows import situation_or_interaction
+from ..core.rows import EncounterSummary, situation_or_interaction
+from ..timebase import DISPLAY_TIME_FORMAT
 from .chart_plot import Bounds, draw_chart, geographic_axes, show_view
 from .html_page import cell_text, file_links, page, sortable_table
 
 if TYPE_CHECKING:
     from ..charts.water import Chart
 
-ENCOUNTER_TABLE_COLUMNS = (
+# Key columns first, so that the table fits a desktop window (1400 px); the others are
+# shown by the "more columns" box (the encounter's section lists every fact anyway).
+KEY_COLUMNS = (
     "encounter",
     "pair",
     "trigger (UTC)",
+    "situation",
+    "give-way",
+    "min sep (m)",
+    "give-way acted",
+    "deciding rule",
+)
+MORE_COLUMNS = (
     "own",
     "target",
-    "situation",
     "own role (final)",
     "target role (final)",
     "rule 9",
-    "deciding rule",
     "CPA (m)",
-    "min sep (m)",
     "data covers CPA",
-    "give-way acted",
 )
+ENCOUNTER_TABLE_COLUMNS = KEY_COLUMNS + MORE_COLUMNS
 # The table's columns offered as selects.
 _SELECTS = tuple(
     ENCOUNTER_TABLE_COLUMNS.index(name)
     for name in (
         "pair",
         "situation",
-        "rule 9",
-        "deciding rule",
-        "data covers CPA",
         "give-way acted",
+        "deciding rule",
+        "rule 9",
+        "data covers CPA",
     )
 )
 
@@ -65,23 +75,42 @@ def pair_numbers(result: ReplayResult) -> dict[str, int]:
     return {pair.summary.pair_id: number for number, pair in enumerate(result.pairs, start=1)}
 
 
+def _give_way(summary: EncounterSummary) -> str:
+    """The vessel(s) that keep out of the way at the end (final roles): blank without a
+    verdict, ``none`` when neither does."""
+    own, target = summary.own_role_final, summary.target_role_final
+    if own is None and target is None:
+        return ""
+    vessels = [
+        _vessel(name, mmsi)
+        for role, name, mmsi in (
+            (own, summary.own_name, summary.own_mmsi),
+            (target, summary.target_name, summary.target_mmsi),
+        )
+        if role is Role.GIVE_WAY
+    ]
+    return ", ".join(vessels) if vessels else "none"
+
+
 def _encounter_row(outcome: EncounterOutcome, numbers: Mapping[str, int]) -> list[Any]:
+    """The table's row, in ``ENCOUNTER_TABLE_COLUMNS``' order."""
     s = outcome.summary
     return [
         s.encounter_id,
         numbers[s.pair_id],
         s.trigger_utc,
+        situation_or_interaction(s),
+        _give_way(s),
+        s.actual_min_separation_m,
+        s.give_way_vessel_acted,
+        "" if s.deciding_rule is None else f"rule {cell_text(s.deciding_rule)}",
         _vessel(s.own_name, s.own_mmsi),
         _vessel(s.target_name, s.target_mmsi),
-        situation_or_interaction(s),
         cell_text(s.own_role_final),
         cell_text(s.target_role_final),
         "" if s.rule9_applied is None else "applied" if s.rule9_applied else "not applied",
-        "" if s.deciding_rule is None else f"rule {cell_text(s.deciding_rule)}",
         s.cpa_m,
-        s.actual_min_separation_m,
         s.data_covers_cpa,
-        s.give_way_vessel_acted,
     ]
 
 
@@ -271,6 +300,72 @@ def overview_svg(result: ReplayResult, chart: Chart | None) -> str:
     return svg[svg.index("<svg") :].replace(' target="_blank"', "")
 
 
+def _names(entries: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The file names (no directories) of run.json's ``inputs`` or ``charts``."""
+    return [Path(str(entry["path"])).name for entry in entries]
+
+
+def _listed(names: Sequence[str], most: int = 3) -> str:
+    shown = ", ".join(names[:most])
+    return shown + (f" and {len(names) - most} more" if len(names) > most else "")
+
+
+def _span(first: pd.Timestamp, last: pd.Timestamp) -> str:
+    start = first.strftime(DISPLAY_TIME_FORMAT)
+    # The end's date only when it is another day.
+    end = last.strftime("%H:%M:%S" if first.date() == last.date() else DISPLAY_TIME_FORMAT)
+    return f"{start} – {end} UTC"
+
+
+def time_span(result: ReplayResult) -> tuple[str, str] | None:
+    """The time span the page names, and what it is: the query's window when it has both
+    ends, else the first and last trigger (the run keeps no span of the data read); None
+    without either."""
+    window = result.manifest.get("query", {}).get("time") or {}
+    if window.get("start") is not None and window.get("end") is not None:
+        return _span(pd.Timestamp(window["start"]), pd.Timestamp(window["end"])), "query window"
+    triggers = [outcome.summary.trigger_utc for outcome in result.encounters]
+    if not triggers:
+        return None
+    return _span(min(triggers), max(triggers)), "first to last trigger"
+
+
+def page_title(result: ReplayResult) -> str:
+    """E.g. ``Replay of a.csv, 2022-01-03 00:00:09 – 00:13:17 UTC, query all, chart
+    US5CA72M.000``: the inputs, time span, query and charts, as the page's first line
+    gives them in full."""
+    inputs = _names(result.manifest.get("inputs", []))
+    charts = _names(result.manifest.get("charts", []))
+    span = time_span(result)
+    parts = [f"Replay of {_listed(inputs)}" if inputs else "Replay"]
+    if span is not None:
+        parts.append(span[0])
+    parts.append(f"query {result.query_name}")
+    if charts:
+        parts.append(f"chart{'s' if len(charts) > 1 else ''} {_listed(charts)}")
+    return ", ".join(parts)
+
+
+def _first_line(result: ReplayResult) -> str:
+    inputs = _names(result.manifest.get("inputs", []))
+    charts = _names(result.manifest.get("charts", []))
+    span = time_span(result)
+    description = result.manifest.get("query", {}).get("description")
+    query = html.escape(result.query_name) + (
+        f" ({html.escape(description)})" if description else ""
+    )
+    parts = [
+        f"<b>Input{'s' if len(inputs) != 1 else ''}:</b> "
+        + (html.escape(", ".join(inputs)) if inputs else "none named"),
+        "<b>Time span:</b> "
+        + ("none (no trigger)" if span is None else f"{html.escape(span[0])} ({span[1]})"),
+        f"<b>Query:</b> {query}",
+        f"<b>Chart{'s' if len(charts) != 1 else ''}:</b> "
+        + (html.escape(", ".join(charts)) if charts else "none"),
+    ]
+    return '<p class="inputs">' + ". ".join(parts) + ".</p>"
+
+
 def replay_html(
     result: ReplayResult,
     chart: Chart | None,
@@ -281,9 +376,10 @@ def replay_html(
     """The replay's index.html (see the module docstring); ``files`` are the report's other
     files written beside it, linked from the top."""
     counts = result.counts
-    title = f"Replay: {result.query_name}"
+    title = page_title(result)
     body = [
         f"<h1>{html.escape(title)}</h1>",
+        _first_line(result),
         f"<p>{counts.vessels} vessels; {counts.encounters} encounters, {counts.triggered} "
         f"triggered (CPA &lt; {result.params.encounters.cpa_req_m:g} m within 0 ≤ TCPA ≤ "
         f"{result.params.encounters.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs; "
@@ -297,6 +393,12 @@ def replay_html(
     rows = [_encounter_row(outcome, numbers) for outcome in result.encounters]
     links = [f"#enc-{outcome.summary.encounter_id}" for outcome in result.encounters]
     if rows:
+        # The script hides the columns from data-from on while the box is not ticked.
+        body.append(
+            '<p><label><input type="checkbox" class="more-columns" id="encounters-more" '
+            f'data-table="encounters" data-from="{len(KEY_COLUMNS)}"> more columns: '
+            f"{html.escape(', '.join(MORE_COLUMNS))}</label></p>"
+        )
         body += sortable_table("encounters", ENCOUNTER_TABLE_COLUMNS, rows, _SELECTS, links)
     else:
         body.append("<p>No triggered encounters.</p>")
