@@ -365,6 +365,14 @@ class _Claims:
         return status if self.belief(status).believed else None
 
 
+def _used_statuses(judge: _Claims, column: pd.Series) -> list[int | None]:
+    """A series' statuses as rules 9 and 18 use them, each distinct claim judged once (a
+    vessel reports the same status for hours)."""
+    reported = [nav_status(v) for v in column.tolist()]
+    used = {status: judge.used(status) for status in set(reported)}
+    return [used[status] for status in reported]
+
+
 def text_or_none(value: Any) -> str | None:
     return None if value is None or (isinstance(value, float) and math.isnan(value)) else str(value)
 
@@ -497,7 +505,7 @@ def _pair_steps(
     )
     states = tuple(_state(series, prefix) for prefix in PREFIXES)
     nav = tuple(
-        [judge.used(nav_status(v)) for v in series[f"{p}nav_status"].tolist()]
+        _used_statuses(judge, series[f"{p}nav_status"])
         for judge, p in zip(claims, PREFIXES, strict=True)
     )
     estimates: tuple[list[Restriction], list[Restriction]] = ([], [])

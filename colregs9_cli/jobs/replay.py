@@ -37,7 +37,7 @@ from ..charts.water import Chart, project_charts
 from ..core.colregs import colregs_params_from_table
 from ..core.encounters import Encounter, check_own_mmsi
 from ..core.manoeuvrability import ManoeuvrabilityParams
-from ..core.pair import evaluate_pair
+from ..core.pair import PairParams, evaluate_pair
 from ..core.replay_results import (
     PairOutcome,
     ReplayCounts,
@@ -290,7 +290,7 @@ def run_replay(
                 results = runner.replay_slabs(
                     slabs,
                     slab_context(segmentation, frame, params),
-                    functools.partial(_evaluate, params=params),
+                    functools.partial(_evaluate, params=params.pair),
                     chart,
                     bar,
                 )
@@ -365,10 +365,10 @@ def _evaluate(
     encounter: Encounter,
     seats: tuple[int, ...],
     chart: Chart | None,
-    params: ReplayRunParams,
+    params: PairParams,
 ) -> PairOutcome:
     """One triggered pair's outcome: evaluated once, then projected onto its reported seats."""
-    return pair_outcome(evaluate_pair(tracks, encounter, chart, params.pair), seats, tracks.frame)
+    return pair_outcome(evaluate_pair(tracks, encounter, chart, params), seats, tracks.frame)
 
 
 def slab_range(segmentation: Segmentation, params: ReplayParams) -> list[int]:

@@ -129,13 +129,7 @@ class ReplayParams:
 
     @property
     def conduct(self) -> ConductParams:
-        return ConductParams(
-            self.course_change_deg,
-            self.speed_change_frac,
-            self.speed_change_min_kn,
-            self.course_judged_above_kn,
-            self.stopped_below_kn,
-        )
+        return _stage_part(self, ConductParams)
 
     @property
     def interactions(self) -> InteractionParams:
@@ -147,7 +141,7 @@ class ReplayParams:
 
     @property
     def rule9(self) -> Rule9Params:
-        return Rule9Params(self.restricted_nav_statuses, self.reassess_every_s)
+        return _stage_part(self, Rule9Params)
 
     @property
     def dimension_defaults(self) -> DimensionDefaults:
