@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import errno
 import os
 import sys
 from collections.abc import Iterator, Sequence
@@ -150,6 +151,17 @@ def _user_errors() -> Iterator[None]:
     except Colregs9Error as exc:
         typer.echo(f"Error: {_one_line(str(exc))}", err=True)
         raise typer.Exit(exc.exit_code) from None
+    except OSError as exc:
+        # Python 3.11's Path.exists, is_file and is_dir raise this one, wherever a path is
+        # first looked at.
+        if exc.errno != errno.ENAMETOOLONG:
+            raise
+        typer.echo(
+            f"Error: {_one_line(str(exc.filename))}: a file name longer than the file system "
+            "allows; give a shorter one",
+            err=True,
+        )
+        raise typer.Exit(2) from None
 
 
 def _out_file(raw: str | None) -> Path | None:
@@ -279,6 +291,17 @@ def replay_command(
         bool,
         typer.Option("--overwrite", help=OVERWRITE_HELP),
     ] = False,
+    domains: Annotated[
+        str,
+        typer.Option(
+            "--domains",
+            metavar="all|restricted|none",
+            help="Ship-domain ellipses in report.gpkg: restricted, those not inside navigable "
+            "water (what an auditor checks against the chart); all, every ellipse of every "
+            "assessment, red, blue and grey (10 of the 13 MB of the San Diego fixture's "
+            "report.gpkg); none.",
+        ),
+    ] = "restricted",
     slab_minutes: Annotated[
         float | None,
         typer.Option(
@@ -357,6 +380,7 @@ def replay_command(
             workers=workers,
             scheduler=scheduler,
             scratch_dir=scratch,
+            domains=domains,
         )
     typer.echo(result.text, nl=False)
     if not quiet:
@@ -602,7 +626,8 @@ def chart_command(
             "--out",
             metavar="FILE.png|FILE.gpkg",
             help="With --draught: the plot (.png; default reports/chart-<stem>.png) or a "
-            "GeoPackage in WGS84 with the depth areas, coverage, land and navigable water (.gpkg).",
+            "GeoPackage in WGS84 with the depth areas, coverage, land, navigable water and the "
+            "charted channels with their axes (.gpkg).",
         ),
     ] = None,
     accept_chart_gaps: Annotated[
@@ -615,7 +640,8 @@ def chart_command(
     ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
-    """Summarise charts: layers, depth range, extent; with --draught, the navigable water.
+    """Summarise charts: layers, depth range, extent, charted channels; with --draught, the
+    navigable water.
 
     \b
     Example:
@@ -668,6 +694,15 @@ def demo_command(
             help="Query TOML with the paper's parameters. Default: the package's greenhopper.toml.",
         ),
     ] = None,
+    domains: Annotated[
+        str,
+        typer.Option(
+            "--domains",
+            metavar="all|restricted|none",
+            help="Ship-domain ellipses in each replay's report.gpkg: all (as the paper's "
+            "figures draw them, red and blue), restricted or none (see replay --domains).",
+        ),
+    ] = "all",
     overwrite: Annotated[bool, typer.Option("--overwrite", help=OVERWRITE_HELP)] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help=QUIET_HELP)] = False,
 ) -> None:
@@ -692,6 +727,7 @@ def demo_command(
             chart=chart or DEFAULT_CHART,
             query=query or DEFAULT_QUERY,
             overwrite=overwrite,
+            domains=domains,
         )
     typer.echo(result.text, nl=False)
 

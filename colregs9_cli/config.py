@@ -9,6 +9,7 @@ file, the table and the key.
 from __future__ import annotations
 
 import dataclasses
+import stat
 import tomllib
 import types
 import typing
@@ -18,19 +19,35 @@ from typing import Any, TypeVar
 from .errors import InputFileError, ParameterError, QueryError
 
 T = TypeVar("T")
+# tomllib parses nested arrays and inline tables recursively, so hundreds of levels exhaust
+# Python's stack; no file colregs9 reads nests them more than 2 deep (a scenario's route).
+TOO_DEEP = (
+    "arrays or inline tables nested hundreds of levels deep, too deep to read (colregs9's "
+    "files nest them 2 deep at most)"
+)
 
 
 def read_toml(path: Path) -> dict[str, Any]:
     """Read a TOML file; a missing file or a syntax error becomes one clear error."""
-    if path.is_dir():
+    try:
+        status = path.stat()
+    except FileNotFoundError:
+        raise InputFileError(f"{path}: no such file; check the path") from None
+    except OSError as exc:  # a symbolic link that loops, a name too long, a file on the way
+        raise InputFileError(
+            f"{path}: cannot open it ({exc.strerror}); check the path and its symbolic links"
+        ) from None
+    if stat.S_ISDIR(status.st_mode):
         raise InputFileError(f"{path}: a directory, not a file; give the TOML file")
-    if not path.is_file():
-        raise InputFileError(f"{path}: no such file; check the path")
+    if not stat.S_ISREG(status.st_mode):  # reading a pipe would wait for a writer
+        raise InputFileError(f"{path}: a pipe or a device, not a file; give the TOML file")
     try:
         with path.open("rb") as handle:
             return tomllib.load(handle)
     except tomllib.TOMLDecodeError as exc:
         raise QueryError(f"{path}: TOML syntax error: {exc}; fix the file") from None
+    except RecursionError:
+        raise QueryError(f"{path}: {TOO_DEEP}; fix the file") from None
     except UnicodeDecodeError as exc:
         raise QueryError(f"{path}: not UTF-8 text ({exc.reason}); save it as UTF-8") from None
     except ValueError:  # an integer of more digits than Python converts

@@ -156,9 +156,12 @@ NAMED_FILES = 3
 
 def report_manifest(directory: Path) -> dict[str, Any] | None:
     """The run.json of the colregs9 report in ``directory``; None where there is none."""
+    marker = directory / REPORT_MARKER
+    if not marker.is_file():  # a pipe of that name would block the read
+        return None
     try:
-        manifest = json.loads((directory / REPORT_MARKER).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+        manifest = json.loads(marker.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):  # RecursionError: JSON nested thousands deep
         return None
     if isinstance(manifest, dict) and manifest.get("tool") == "colregs9":
         return manifest
@@ -266,6 +269,7 @@ def check_out_dir(
     files colregs9 did not write there (those its run.json does not list; all of them where
     there is no run.json), naming the first few. With ``overwrite`` the report replaces the
     colregs9 files there and leaves the others (``report_directory``)."""
+    _check_reachable(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise OutputError(f"{out_dir}: --out is a file, not a directory; give a directory")
     existing = out_dir
@@ -281,20 +285,37 @@ def check_out_dir(
         raise OutputError(
             f"{out_dir}: no permission to write in {writable_in}; give a directory you can write to"
         )
-    resolved = out_dir.resolve()
+    # realpath, unlike Path.resolve, leaves a symbolic link that loops as it is (and raises
+    # nothing): such an input is neither --out nor above it, and its reader names it.
+    resolved = Path(os.path.realpath(out_dir))
     if resolved in (Path.cwd().resolve(), *Path.cwd().resolve().parents, Path.home().resolve()):
         raise OutputError(
             f"{out_dir}: --out would replace the current, a parent or the home directory; "
             "give a directory of its own for the report"
         )
     for given in inputs:
-        if resolved == Path(given).resolve() or resolved in Path(given).resolve().parents:
+        input_path = Path(os.path.realpath(given))
+        if resolved == input_path or resolved in input_path.parents:
             raise OutputError(
                 f"{out_dir}: --out is or holds the input {given}, which the report would "
                 "replace; give another directory for the report"
             )
     if out_dir.is_dir():
         _check_what_is_there(out_dir, overwrite, command)
+
+
+def _check_reachable(out_dir: Path) -> None:
+    """Refuse an ``--out`` that no path reaches: through a symbolic link that loops, or a
+    name too long. A missing one, or one under a file, is for ``check_out_dir`` to say."""
+    try:
+        out_dir.stat()
+    except (FileNotFoundError, NotADirectoryError):
+        return
+    except OSError as exc:
+        raise OutputError(
+            f"{out_dir}: --out cannot be reached ({exc.strerror}); check the path and its "
+            "symbolic links, or give another directory"
+        ) from None
 
 
 def _check_what_is_there(out_dir: Path, overwrite: bool, command: str) -> None:

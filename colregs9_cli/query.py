@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -418,8 +419,10 @@ def _polygon_from_text(text: Any, where: str) -> Polygon | MultiPolygon:
 def _polygon_from_file(query_path: Path, relative: Any) -> Polygon | MultiPolygon:
     if not isinstance(relative, str) or "\0" in relative:
         raise QueryError(f"{query_path}: [region] polygon_file = {relative!r}; give a path")
+    # realpath leaves a symbolic link that loops as it is (Path.resolve raises RuntimeError),
+    # so that stat reports it as the OSError below.
+    polygon_path = Path(os.path.realpath(query_path.parent / relative))
     try:
-        polygon_path = (query_path.parent / relative).resolve()
         polygon_path.stat()
     except FileNotFoundError:
         pass
@@ -433,9 +436,14 @@ def _polygon_from_file(query_path: Path, relative: Any) -> Polygon | MultiPolygo
             f"{query_path}: [region] polygon_file {relative!r} is {polygon_path}, a directory, "
             "not a file; give a GeoJSON file"
         )
-    if not polygon_path.is_file():
+    if not polygon_path.exists():
         raise InputFileError(
             f"{query_path}: [region] polygon_file {relative!r}: no such file {polygon_path}"
+        )
+    if not polygon_path.is_file():  # a pipe's read would wait for a writer
+        raise InputFileError(
+            f"{query_path}: [region] polygon_file {relative!r} is {polygon_path}, a pipe or a "
+            "device, not a file; give a GeoJSON file"
         )
     try:
         text = polygon_path.read_text(encoding="utf-8")

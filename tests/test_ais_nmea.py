@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
+import functools
 import gzip
+import itertools
 from collections.abc import Iterator
-from datetime import UTC, datetime
+from datetime import UTC, datetime, timedelta
 from functools import reduce
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from pyais import encode_dict
+from pyais.util import compute_checksum
 
 from colregs9_cli.ais.batch import AisBatch
 from colregs9_cli.ais.clean import SHIP_TYPE_CATEGORIES
@@ -717,3 +721,300 @@ def test_an_invalid_mmsi_is_quoted_with_the_line_of_its_message(tmp_path: Path) 
         f"{log}:2: MMSI 2190045",
         f"{log}:5: static report: MMSI 11388",
     ]
+
+
+# --- $PGHP matched to its sentence by checksum (exactEarth/AMSA satellite logs) -----------
+# exactEarth's logs for AMSA write each sentence's $PGHP with the sentence's checksum in its
+# 14th field, before, after or a few lines away from it, and terrestrial sentences with no
+# $PGHP among them; each line ends with its arrival at the archive in ms (docs: nmea_pghp.py):
+#   $PGHP,1,2012,1,31,5,7,2,151,316,2,316000002,1AIS_S,51*77,1327992119157
+#   !AIVDM,1,1,,B,IFICEMae<`HfcEV4M8aEWM<2VH1j6?;6<t9>,0*51,1327992119173
+
+SAT_PASS = datetime(2012, 1, 31, 5, 7, 2, 151_000, tzinfo=UTC)
+ARCHIVED_MS = round(SAT_PASS.timestamp() * 1000) + 90 * 60_000  # 1.5 h after the pass
+SHUFFLE_REACH = 3  # a line moves at most 2 * 3 places: a $PGHP stays within 13 lines
+
+
+def _ee_pghp(when: datetime, checksum: int | str) -> str:
+    field = checksum if isinstance(checksum, str) else f"{checksum:02X}"
+    body = (
+        f"PGHP,1,{when.year},{when.month},{when.day},{when.hour},{when.minute},{when.second},"
+        f"{when.microsecond // 1000},316,2,316000002,1AIS_S,{field}"
+    )
+    return f"${body}*{_checksum(body)}"
+
+
+def _archived(line: str, index: int) -> str:
+    return f"{line},{ARCHIVED_MS + index}"
+
+
+def _distinct_positions(count: int, taken: set[int]) -> list[tuple[str, dict[str, object]]]:
+    """Real type 1 and 18 sentences from pyais's encoder, no two with one checksum."""
+    found: list[tuple[str, dict[str, object]]] = []
+    step = 0
+    while len(found) < count:
+        step += 1
+        fields: dict[str, object] = {
+            "type": 18 if step % 3 == 0 else 1,
+            "mmsi": 503_000_000 + step % 7,
+            "lat": round(-33.0 - step * 0.0013, 4),
+            "lon": round(151.2 + step * 0.0021, 4),
+            "speed": 12.3,
+            "course": 45.6,
+        }
+        (sentence,) = _sentences(channel="AB"[step % 2], **fields)
+        checksum = compute_checksum(sentence)
+        if checksum not in taken:
+            taken.add(checksum)
+            found.append((sentence, fields))
+    return found
+
+
+@functools.cache
+def _satellite_log() -> tuple[list[str], dict[tuple[object, ...], datetime], int]:
+    """40 satellite sentences each after its $PGHP (times out of order, as a satellite
+    sends what it stored), 5 terrestrial ones without; every checksum different. Returns
+    the lines, each position's observation time, and how many are satellite ones."""
+    taken: set[int] = set()
+    satellite = _distinct_positions(40, taken)
+    terrestrial = _distinct_positions(5, taken)
+    lines: list[str] = []
+    times: dict[tuple[object, ...], datetime] = {}
+    for n, (sentence, fields) in enumerate(satellite):
+        when = SAT_PASS + pd.Timedelta(seconds=(n * 37) % 300, milliseconds=n * 7)
+        lines += [_ee_pghp(when, compute_checksum(sentence)), sentence]
+        times[(fields["mmsi"], fields["lat"], fields["lon"])] = when
+        if n % 8 == 3:
+            lines.append(terrestrial[n // 8][0])
+    return [_archived(line, i) for i, line in enumerate(lines)], times, len(satellite)
+
+
+def _shuffled(lines: list[str], offsets: list[int]) -> list[str]:
+    """Each line moved by its offset (ties keep the order): a shuffle within a window."""
+    order = sorted(range(len(lines)), key=lambda i: (i + offsets[i], i))
+    return [lines[i] for i in order]
+
+
+def _positions_by_report(batch: AisBatch) -> dict[tuple[object, ...], datetime]:
+    return {
+        (row["mmsi"], row["lat_deg"], row["lon_deg"]): row["timestamp"]
+        for row in _rows(batch.positions)
+    }
+
+
+def _seeded_shuffle(lines: list[str]) -> list[str]:
+    rng = np.random.default_rng(31)
+    return _shuffled(lines, list(rng.integers(-SHUFFLE_REACH, SHUFFLE_REACH + 1, len(lines))))
+
+
+def test_a_shuffled_satellite_log_gives_every_sentence_its_pghp_time() -> None:
+    lines, times, satellite = _satellite_log()
+    shuffled = _seeded_shuffle(lines)
+    after = sum(
+        1
+        for prev, line in itertools.pairwise(shuffled)
+        if prev.startswith("$PGHP") and line.split("*")[1][:2] == prev.split(",")[13][:2]
+    )
+    assert after < satellite * 0.7  # most $PGHP lines no longer right before their sentence
+    batch, ledger = _read(shuffled)
+    got = _positions_by_report(batch)
+    assert {key: got[key] for key in times} == times  # every one its observation, none late
+    terrestrial = [when for key, when in got.items() if key not in times]
+    assert len(terrestrial) == 5
+    assert all(when > SAT_PASS + pd.Timedelta(minutes=89) for when in terrestrial)  # arrival
+    assert ledger.time_sources == {"pghp": satellite, "arrival": 5}
+    assert ledger.pghp_pairing == {
+        "matched": satellite,
+        "adjacent": 0,
+        "unmatched": 5,
+        "pghp_unmatched": 0,
+    }
+    assert ledger.to_dict()["pghp_pairing"] == dict(sorted(ledger.pghp_pairing.items()))
+
+
+def test_adjacency_alone_would_time_the_shuffled_log_wrongly() -> None:
+    """What the checksum fixes: the line after each $PGHP is mostly another sentence."""
+    lines, times, _ = _satellite_log()
+    epoch = datetime(1970, 1, 1, tzinfo=UTC)
+    # The same shuffled log with each $PGHP's checksum field emptied: it times the next line.
+    blinded = [
+        _ee_pghp(epoch + timedelta(milliseconds=pghp_time_ms(line) or 0), "")
+        if line.startswith("$PGHP")
+        else line
+        for line in _seeded_shuffle(lines)
+    ]
+    batch, ledger = _read(blinded)
+    got = _positions_by_report(batch)
+    assert sum(got[key] != when for key, when in times.items()) > len(times) / 3
+    assert ledger.pghp_pairing["adjacent"] > 0 and ledger.pghp_pairing["matched"] == 0
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.data())
+def test_any_shuffle_within_the_window_decodes_like_the_unshuffled_log(
+    data: st.DataObject,
+) -> None:
+    lines, _, _ = _satellite_log()
+    offsets = data.draw(
+        st.lists(
+            st.integers(-SHUFFLE_REACH, SHUFFLE_REACH), min_size=len(lines), max_size=len(lines)
+        )
+    )
+    plain, plain_ledger = _read(lines)
+    shuffled, ledger = _read(_shuffled(lines, offsets))
+    columns = ["mmsi", "timestamp", "lat_deg", "lon_deg", "sog_kn", "cog_deg"]
+    expected = plain.positions.to_pandas()[columns].sort_values(columns, ignore_index=True)
+    got = shuffled.positions.to_pandas()[columns].sort_values(columns, ignore_index=True)
+    pd.testing.assert_frame_equal(got, expected)
+    assert ledger.time_sources == plain_ledger.time_sources
+    assert ledger.pghp_pairing == plain_ledger.pghp_pairing
+
+
+def test_an_unmatched_pghp_and_an_unmatched_sentence_are_counted() -> None:
+    taken: set[int] = set()
+    (mine, mine_fields), (orphan, _), (far, far_fields) = _distinct_positions(3, taken)
+    # its sentence never reached the log (and not 00, which DMA writes before an own report)
+    lost = next(c for c in range(1, 256) if c not in taken)
+    lines = [
+        _archived(_ee_pghp(SAT_PASS, compute_checksum(mine)), 0),
+        _archived(mine, 1),
+        # A $PGHP whose sentence is missing, right before a sentence with no $PGHP: the
+        # checksums disagree, so neither times the other.
+        _archived(_ee_pghp(SAT_PASS + pd.Timedelta(seconds=9), lost), 2),
+        _archived(orphan, 3),
+        # A $PGHP 16 lines before its sentence, with other sentences between (a station's
+        # status lines here): beyond the window, both stay unmatched.
+        _archived(_ee_pghp(SAT_PASS + pd.Timedelta(seconds=20), compute_checksum(far)), 4),
+        *[
+            status
+            for status in (f"$PSTT,10A,{i}*{_checksum(f'PSTT,10A,{i}')}" for i in range(16))
+            if compute_checksum(status) != compute_checksum(far)
+        ][:15],
+        _archived(far, 20),
+    ]
+    batch, ledger = _read(lines)
+    got = _positions_by_report(batch)
+    assert got[(mine_fields["mmsi"], mine_fields["lat"], mine_fields["lon"])] == SAT_PASS
+    assert got[(far_fields["mmsi"], far_fields["lat"], far_fields["lon"])] > SAT_PASS + (
+        pd.Timedelta(minutes=89)
+    )
+    assert ledger.time_sources == {"pghp": 1, "arrival": 2}
+    assert ledger.pghp_pairing == {
+        "matched": 1,
+        "adjacent": 0,
+        "unmatched": 2,
+        "pghp_unmatched": 2,
+    }
+
+
+def _two_with_one_checksum() -> tuple[tuple[int, str], tuple[int, str]]:
+    """Two position sentences (MMSI, sentence) of two vessels whose checksums are equal."""
+    seen: dict[int, tuple[int, str]] = {}
+    for mmsi in range(503_100_000, 503_102_000):
+        sentence = _position(mmsi=mmsi, lat=-33.5, lon=151.5)
+        checksum = compute_checksum(sentence)
+        if checksum in seen:
+            return seen[checksum], (mmsi, sentence)
+        seen[checksum] = (mmsi, sentence)
+    raise AssertionError("no two sentences with one checksum")
+
+
+@pytest.mark.parametrize(
+    ("before", "after", "winner"),
+    [
+        (1, 3, "earlier"),  # the nearer one wins
+        (2, 2, "later"),  # a tie: the following one, where a $PGHP normally is
+        (3, 1, "later"),
+    ],
+)
+def test_two_sentences_with_the_pghps_checksum_in_the_window(
+    before: int, after: int, winner: str
+) -> None:
+    (earlier_mmsi, earlier), (later_mmsi, later) = _two_with_one_checksum()
+    checksum = compute_checksum(earlier)
+    # sentences with no $PGHP between them, their checksums all different
+    filler = [_position(mmsi=503_200_000 + i, lat=-34.0 - i / 100, lon=152.0) for i in range(6)]
+    assert checksum not in {compute_checksum(f) for f in filler}
+    lines = [earlier, *filler[: before - 1], _ee_pghp(SAT_PASS, checksum)]
+    lines += [*filler[3 : 3 + after - 1], later]
+    batch, ledger = _read([_archived(line, i) for i, line in enumerate(lines)])
+    by_mmsi = {row["mmsi"]: row["timestamp"] for row in _rows(batch.positions)}
+    timed = {"earlier": by_mmsi[earlier_mmsi], "later": by_mmsi[later_mmsi]}
+    loser = "later" if winner == "earlier" else "earlier"
+    assert timed[winner] == SAT_PASS
+    assert timed[loser] > SAT_PASS + pd.Timedelta(minutes=89)  # its arrival
+    assert ledger.pghp_pairing["matched"] == 1
+    assert ledger.pghp_pairing["unmatched"] == len(lines) - 2
+
+
+@pytest.mark.parametrize("where", ["right before", "after it", "first fragment's only"])
+def test_a_multi_sentence_message_is_matched_by_the_xor_of_its_fragments(where: str) -> None:
+    fragments = _type5(mmsi=503_300_000)
+    whole = reduce(lambda acc, s: acc ^ compute_checksum(s), fragments, 0)
+    assert whole != compute_checksum(fragments[0])
+    other = _position(mmsi=503_300_001)
+    lines = {
+        "right before": [_ee_pghp(SAT_PASS, whole), *fragments, other],
+        "after it": [*fragments, other, _ee_pghp(SAT_PASS, whole)],
+        "first fragment's only": [_ee_pghp(SAT_PASS, compute_checksum(fragments[0])), *fragments],
+    }[where]
+    batch, ledger = _read([_archived(line, i) for i, line in enumerate(lines)])
+    (static,) = _rows(batch.statics)
+    if where == "first fragment's only":
+        assert static["timestamp"] > SAT_PASS + pd.Timedelta(minutes=89)
+        assert ledger.pghp_pairing["pghp_unmatched"] == 1
+    else:
+        assert static["timestamp"] == SAT_PASS
+        assert ledger.pghp_pairing["matched"] == 1
+
+
+def test_a_pghp_without_checksum_or_with_dmas_00_times_the_next_sentence() -> None:
+    observed = datetime(2013, 11, 12, 12, 3, 14, 159_000, tzinfo=UTC)
+    _, no_field = _read([_satellite_pghp(observed), _position()])
+    assert no_field.pghp_pairing == {
+        "matched": 0,
+        "adjacent": 1,
+        "unmatched": 0,
+        "pghp_unmatched": 0,
+    }
+    # DMA writes 00 before its base stations' own !xxVDO reports (rule 3)
+    own = _position(mmsi=219_000_123).replace("!AIVDM", "!BSVDO")
+    own = f"{own.split('*')[0]}*{compute_checksum(own):02X}"
+    assert compute_checksum(own) != 0
+    batch, ledger = _read([_pghp(observed), own])
+    assert _rows(batch.positions)[0]["timestamp"] == observed
+    assert ledger.pghp_pairing["adjacent"] == 1
+
+
+def test_dma_every_message_keeps_the_time_of_the_pghp_right_before_it(
+    fixtures_dir: Path, dma: tuple[AisBatch, RejectsLedger]
+) -> None:
+    """The DMA fixture is read as before: worked out here by adjacency alone."""
+    with gzip.open(
+        fixtures_dir / "ais" / "dma_nmea_2013-11-12_5min.txt.gz", "rt", encoding="ascii"
+    ) as log:
+        lines = log.read().splitlines()
+    expected: dict[int, int] = {}
+    last: int | None = None
+    for line_no, line in enumerate(lines, start=1):
+        if line.startswith("$PGHP"):
+            last = pghp_time_ms(line)
+        elif line.startswith("!") or line.startswith("$"):
+            fields = line.split(",")
+            if line[3:6] in ("VDM", "VDO") and fields[2] == "1" and last is not None:
+                expected[line_no] = last
+            last = None
+    batch, ledger = dma
+    for table, table_lines in (
+        (batch.positions, batch.position_lines),
+        (batch.statics, batch.static_lines),
+    ):
+        assert table_lines is not None
+        got = table.column("timestamp").cast("int64").to_pylist()
+        assert got == [expected[int(n)] for n in table_lines]
+    assert ledger.pghp_pairing == {
+        "matched": 25_604,
+        "adjacent": 473,  # the base stations' own !BSVDO/!AIVDO reports: 00 (rule 3)
+        "unmatched": 0,
+        "pghp_unmatched": 0,
+    }

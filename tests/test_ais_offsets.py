@@ -28,7 +28,7 @@ from colregs9_cli.ais.load import load_ais
 from colregs9_cli.ais.nmea import read_nmea
 from colregs9_cli.ais.schema import ANTENNA_OFFSETS, CANONICAL_COLUMNS, CANONICAL_SCHEMA
 from colregs9_cli.core.hull import HullOffsets, centred_offsets
-from colregs9_cli.core.pair import hull_offsets, least_hull_separation_m
+from colregs9_cli.core.pair_audit import hull_offsets, least_hull_separation_m
 from colregs9_cli.core.tracks import ANTENNA_OFFSET_COLUMNS, STATIC_COLUMNS, latest_statics
 from colregs9_cli.core.vessel_defaults import VesselDimensions
 from colregs9_cli.errors import InputFileError
@@ -434,8 +434,8 @@ def test_ingest_into_a_version_1_dataset_upgrades_its_manifest(
     shutil.copytree(version_1, dataset)
     ingest([DMA22, NMEA], dataset)
     manifest = json.loads((dataset / MANIFEST_NAME).read_text())
-    assert manifest["format_version"] == 2 and manifest["schema"] == manifest_schema()
-    assert [entry["format_version"] for entry in manifest["inputs"]] == [1, 2, 2]
+    assert manifest["format_version"] == 3 and manifest["schema"] == manifest_schema()
+    assert [entry["format_version"] for entry in manifest["inputs"]] == [1, 3, 3]
     positions = load_ais([dataset]).positions
     from_nmea = positions["timestamp"].dt.year == 2013
     assert positions.loc[from_nmea, "to_bow_m"].notna().sum() > 1000  # the new input's
@@ -470,7 +470,7 @@ def test_a_version_1_dataset_with_files_of_another_schema_is_refused(
     [
         (2, 1, "not the canonical schema of format version 2; re-create the dataset"),
         (1, 2, "not the canonical schema of format version 1; re-create the dataset"),
-        (3, 2, "format version 3, this colregs9 reads versions 1, 2"),
+        (4, 2, "format version 4, this colregs9 reads versions 1, 2, 3"),
     ],
 )
 def test_a_manifest_whose_version_and_schema_disagree_is_refused(

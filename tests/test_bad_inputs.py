@@ -18,6 +18,7 @@ import io
 import json
 import lzma
 import os
+import re
 import shutil
 import struct
 import subprocess
@@ -1008,3 +1009,356 @@ def test_as_a_console_script_of_its_own(case_id: str, cases, work: Path) -> None
         check=False,
     )
     _check(case, done.returncode, done.stdout, done.stderr, None, work)
+
+
+# Issue 31 §2: inputs that gave a traceback (an AIS path that is a symbolic link that loops, a
+# Parquet column twice, TOML nested thousands deep) and their siblings. Each refusal's whole
+# Error line is checked; ``names`` holds it, after "Error: ".
+LOOP = "Too many levels of symbolic links"
+NAME_MAX = 255  # bytes in one path component, on the file systems pytest runs on
+
+
+def _link(work: Path, name: str, target: str) -> str:
+    path = work / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not os.path.lexists(path):
+        path.symlink_to(target)
+    return name
+
+
+def _fifo(work: Path, name: str) -> str:
+    if not os.path.lexists(work / name):
+        os.mkfifo(work / name)
+    return name
+
+
+def _spoilt_dataset(work: Path, name: str) -> Path:
+    """A copy of the dataset ``ingest`` made for the cases above, to spoil."""
+    copy = work / "datasets" / name
+    if not copy.exists():
+        shutil.copytree(work / "datasets" / "good", copy)
+    return copy
+
+
+def _loop_cases(work: Path) -> list[Case]:
+    loop = _link(work, "loop.csv", "loop.csv")
+    through = _link(work, "loops/a", "b")
+    _link(work, "loops/b", "a")
+    out = _link(work, "out_loop", "out_loop")
+    query = _link(work, "queries/loop.toml", "loop.toml")
+    polygon = _write(work, "queries/polygon_loop.toml", "[region]\npolygon_file = 'loop.toml'\n")
+    parent = _spoilt_dataset(work, "link_to_parent")
+    _link(work, str((parent / "up").relative_to(work)), "..")
+    broken = _spoilt_dataset(work, "broken_link")
+    stray = _link(work, str((broken / "stray.parquet").relative_to(work)), "nowhere.parquet")
+    cannot_open = f"cannot open it ({LOOP}); check the path and its symbolic links"
+    scenario_text = (DEMO_DATA / "greenhopper_restricted.toml").read_text(encoding="utf-8")
+    _link(work, "scenarios/chart_loop.geojson", "chart_loop.geojson")
+    looping_chart = _write(
+        work,
+        "scenarios/chart_loop.toml",
+        re.sub(r"(?m)^chart = .*$", 'chart = "chart_loop.geojson"', scenario_text),
+    )
+    cases = [
+        Case(
+            f"issue31-{command}-ais-symlink-loop",
+            (command, loop, "--out", f"out/i31-{command}-loop", "--quiet"),
+            2,
+            f"{loop}: {cannot_open}",
+        )
+        for command in ("stats", "replay", "ingest")
+    ]
+    return [
+        *cases,
+        Case(
+            "issue31-simulate-scenario-chart-symlink-loop",
+            ("simulate", looping_chart, "--out", "out/i31-scenario.csv", "--quiet"),
+            2,
+            f"{looping_chart}: chart = 'chart_loop.geojson': {LOOP}; give the path of a chart file",
+        ),
+        Case(
+            "issue31-stats-ais-loop-through-a-directory",
+            ("stats", through, "--out", "out/i31-through", "--quiet"),
+            2,
+            f"{through}: {cannot_open}",
+        ),
+        Case(
+            "issue31-stats-out-symlink-loop",
+            ("stats", str(DMA26), "--out", out, "--quiet"),
+            2,
+            f"{out}: --out cannot be reached ({LOOP}); check the path and its symbolic links, "
+            "or give another directory",
+        ),
+        Case(
+            "issue31-stats-out-under-a-symlink-loop",
+            ("stats", str(DMA26), "--out", f"{out}/report", "--quiet"),
+            2,
+            f"{out}/report: --out cannot be reached ({LOOP}); check the path and its symbolic "
+            "links, or give another directory",
+        ),
+        Case(
+            "issue31-stats-query-symlink-loop",
+            ("stats", str(DMA26), "--query", query, "--out", "out/i31-q-loop", "--quiet"),
+            2,
+            f"{query}: {cannot_open}",
+        ),
+        Case(
+            "issue31-stats-polygon-file-symlink-loop",
+            ("stats", str(DMA26), "--query", polygon, "--out", "out/i31-p-loop", "--quiet"),
+            2,
+            f"{polygon}: [region] polygon_file 'loop.toml': {LOOP}; give a path to a GeoJSON file",
+        ),
+        # pathlib's rglob does not follow a link to a directory: the dataset is read as it is.
+        Case(
+            "issue31-stats-dataset-with-a-link-to-its-parent",
+            ("stats", str(parent.relative_to(work)), "--out", "out/i31-parent", "--quiet"),
+            0,
+        ),
+        Case(
+            "issue31-stats-dataset-with-a-broken-link",
+            ("stats", str(broken.relative_to(work)), "--out", "out/i31-broken", "--quiet"),
+            2,
+            f"{stray}: a Parquet file the dataset manifest does not list (a dataset holds only "
+            "what colregs9 ingest wrote); move it out of the dataset, or ingest its source",
+        ),
+    ]
+
+
+def _duplicate_column_cases(work: Path) -> list[Case]:
+    good = work / "datasets" / "good"
+    canonical = pq.read_table(next(good.rglob("*.parquet")))
+    lat = canonical.column("lat_deg")
+    twice = canonical.append_column("lat_deg", lat)
+    lat_twice = _write(work, "lat_twice.parquet", _parquet(twice))
+    unread = canonical.append_column("note", lat).append_column("note", lat)
+    unread_twice = _write(work, "unread_twice.parquet", _parquet(unread))
+    inner = pa.StructArray.from_arrays([lat.combine_chunks()] * 2, names=["x", "x"])
+    struct_twice = _write(
+        work, "struct_twice.parquet", _parquet(canonical.append_column("extra", inner))
+    )
+    dropped = _spoilt_dataset(work, "dropped_lat_twice")
+    pq.write_table(twice, dropped / "date=2024-09-09" / "lat_twice.parquet")
+    rewritten = _spoilt_dataset(work, "rewritten_lat_twice")
+    partition = next(rewritten.rglob("part-*.parquet"))
+    pq.write_table(twice, partition)
+    in_file = (
+        f"{lat_twice}: the Parquet file has the column 'lat_deg' 2 times; write it again with "
+        "each canonical column once"
+    )
+    in_dataset = (
+        f"{partition.relative_to(work)}: has the column 'lat_deg' 2 times; not a file of this "
+        "dataset: move it out, or re-create the dataset with colregs9 ingest"
+    )
+    cases = [
+        Case(
+            f"issue31-{command}-parquet-lat-twice",
+            (command, lat_twice, "--out", f"out/i31-{command}-lat-twice", "--quiet"),
+            2,
+            in_file,
+        )
+        for command in ("stats", "replay", "ingest")
+    ]
+    return [
+        *cases,
+        # Columns colregs9 does not read may repeat: nothing it reads is in doubt.
+        Case(
+            "issue31-stats-parquet-unread-column-twice",
+            ("stats", unread_twice, "--out", "out/i31-unread-twice", "--quiet"),
+            0,
+        ),
+        Case(
+            "issue31-stats-parquet-struct-field-twice",
+            ("stats", struct_twice, "--out", "out/i31-struct-twice", "--quiet"),
+            0,
+        ),
+        Case(
+            "issue31-stats-dataset-with-a-file-dropped-in",
+            ("stats", str(dropped.relative_to(work)), "--out", "out/i31-dropped", "--quiet"),
+            2,
+            f"{dropped.relative_to(work)}/date=2024-09-09/lat_twice.parquet: a Parquet file the "
+            "dataset manifest does not list (a dataset holds only what colregs9 ingest wrote); "
+            "move it out of the dataset, or ingest its source",
+        ),
+        Case(
+            "issue31-stats-dataset-partition-lat-twice",
+            ("stats", str(rewritten.relative_to(work)), "--out", "out/i31-rewritten", "--quiet"),
+            2,
+            in_dataset,
+        ),
+        Case(
+            "issue31-ingest-into-dataset-partition-lat-twice",
+            ("ingest", str(DMA22), "--out", str(rewritten.relative_to(work)), "--quiet"),
+            2,
+            in_dataset,
+        ),
+    ]
+
+
+def _deep_toml_cases(work: Path) -> list[Case]:
+    deep_array = _write(work, "queries/deep_array.toml", "a = " + "[" * 5000 + "]" * 5000 + "\n")
+    deep_inline = _write(
+        work, "queries/deep_inline.toml", "[x]\ny = " + "{a = " * 5000 + "1" + "}" * 5000 + "\n"
+    )
+    deep_map = _write(work, "deep_map.toml", "name = " + "[" * 5000 + "]" * 5000 + "\n")
+    digits_map = _write(work, "digits_map.toml", "name = " + "1" * 5000 + "\n")
+    mmsis = [257739000, 371420000, *range(219000000, 219009998)]
+    wide = _write(
+        work, "queries/wide_array.toml", f"[vessels]\nmmsi_include = {json.dumps(mmsis)}\n"
+    )
+    too_deep = (
+        "arrays or inline tables nested hundreds of levels deep, too deep to read (colregs9's "
+        "files nest them 2 deep at most)"
+    )
+    cases = [
+        Case(
+            f"issue31-{command}-query-nested-5000-deep",
+            (command, str(DMA26), "--query", deep_array, "--out", f"out/i31-{command}", "--quiet"),
+            2,
+            f"{deep_array}: {too_deep}; fix the file",
+        )
+        for command in ("stats", "replay", "ingest")
+    ]
+    return [
+        *cases,
+        Case(
+            "issue31-stats-query-inline-tables-5000-deep",
+            ("stats", str(DMA26), "--query", deep_inline, "--out", "out/i31-inline", "--quiet"),
+            2,
+            f"{deep_inline}: {too_deep}; fix the file",
+        ),
+        Case(
+            "issue31-simulate-scenario-nested-5000-deep",
+            ("simulate", deep_array, "--out", "out/i31-deep.csv", "--quiet"),
+            2,
+            f"{deep_array}: {too_deep}; fix the file",
+        ),
+        Case(
+            "issue31-demo-query-nested-5000-deep",
+            ("demo", "--query", deep_array, "--out", "out/i31-demo-deep", "--quiet"),
+            2,
+            f"{deep_array}: {too_deep}; fix the file",
+        ),
+        Case(
+            "issue31-stats-column-map-nested-5000-deep",
+            ("stats", str(DMA26), "--columns", deep_map, "--out", "out/i31-map", "--quiet"),
+            2,
+            f"{deep_map}: {too_deep}; fix the map",
+        ),
+        Case(
+            "issue31-stats-column-map-5000-digits",
+            ("stats", str(DMA26), "--columns", digits_map, "--out", "out/i31-digits", "--quiet"),
+            2,
+            f"{digits_map}: a number of more than 4300 digits; give numbers of a sensible size",
+        ),
+        Case(
+            "issue31-stats-query-10000-mmsis",
+            ("stats", str(DMA26), "--query", wide, "--out", "out/i31-wide", "--quiet"),
+            0,
+        ),
+    ]
+
+
+def _pipe_and_long_name_cases(work: Path) -> list[Case]:
+    query = _fifo(work, "queries/pipe.toml")
+    polygon = _write(work, "queries/polygon_pipe.toml", "[region]\npolygon_file = 'pipe.toml'\n")
+    manifest_pipe = _spoilt_dataset(work, "manifest_pipe")
+    manifest = manifest_pipe / "colregs9-dataset.json"
+    if manifest.is_file():
+        manifest.unlink()
+    _fifo(work, str(manifest.relative_to(work)))
+    deep = _spoilt_dataset(work, "manifest_deep")
+    (deep / "colregs9-dataset.json").write_text("[" * 5000 + "]" * 5000)
+    deep_run_json = _write(work, "out_deep_run_json/run.json", '{"a": ' + "[" * 5000 + "]" * 5000)
+    long_name = "x" * (NAME_MAX + 1) + ".csv"
+    pipe_note = "a pipe or a device, not a file"
+    return [
+        Case(
+            "issue31-stats-query-a-pipe",
+            ("stats", str(DMA26), "--query", query, "--out", "out/i31-q-pipe", "--quiet"),
+            2,
+            f"{query}: {pipe_note}; give the TOML file",
+        ),
+        # Reading these pipes waited for a writer, for ever.
+        Case(
+            "issue31-stats-column-map-a-pipe",
+            ("stats", str(DMA26), "--columns", query, "--out", "out/i31-map-pipe", "--quiet"),
+            2,
+            f"--columns {query}: {pipe_note}; give the map's TOML file",
+        ),
+        Case(
+            "issue31-stats-polygon-file-a-pipe",
+            ("stats", str(DMA26), "--query", polygon, "--out", "out/i31-p-pipe", "--quiet"),
+            2,
+            f"{polygon}: [region] polygon_file 'pipe.toml' is {work.resolve() / query}, "
+            f"{pipe_note}; give a GeoJSON file",
+        ),
+        Case(
+            "issue31-stats-dataset-manifest-a-pipe",
+            ("stats", str(manifest_pipe.relative_to(work)), "--out", "out/i31-m", "--quiet"),
+            2,
+            f"{manifest.relative_to(work)}: not a file; restore the dataset manifest, or "
+            "re-create the dataset with colregs9 ingest",
+        ),
+        Case(
+            "issue31-stats-dataset-manifest-nested-5000-deep",
+            ("stats", str(deep.relative_to(work)), "--out", "out/i31-m-deep", "--quiet"),
+            2,
+            f"{deep.relative_to(work)}/colregs9-dataset.json: the manifest is nested too deeply "
+            "to be one; restore it, or re-create the dataset with colregs9 ingest",
+        ),
+        Case(
+            "issue31-stats-out-holds-run-json-nested-5000-deep",
+            ("stats", str(DMA26), "--out", str(Path(deep_run_json).parent), "--quiet"),
+            2,
+            "out_deep_run_json: --out is not a colregs9 report and holds 1 item(s): run.json; "
+            "give a new or empty directory, or add --overwrite to write the report beside them "
+            "(they are kept)",
+        ),
+        Case(
+            "issue31-stats-ais-name-too-long",
+            ("stats", long_name, "--out", "out/i31-long", "--quiet"),
+            2,
+            f"{long_name}: a file name longer than the file system allows; give a shorter one",
+        ),
+        Case(
+            "issue31-ingest-out-name-too-long",
+            ("ingest", str(DMA26), "--out", long_name, "--quiet"),
+            2,
+            f"{long_name}: a file name longer than the file system allows; give a shorter one",
+        ),
+    ]
+
+
+TRACEBACK_CASES = {
+    c.id: c
+    for c in (
+        *_loop_cases(WORK),
+        *_duplicate_column_cases(WORK),
+        *_deep_toml_cases(WORK),
+        *_pipe_and_long_name_cases(WORK),
+    )
+}
+
+
+@pytest.fixture(scope="module")
+def traceback_results(work: Path) -> dict[str, dict[str, object]]:
+    listed = work / "traceback_cases.json"
+    listed.write_text(
+        json.dumps(
+            [{"id": c.id, "args": list(c.args), "cwd": str(work)} for c in TRACEBACK_CASES.values()]
+        )
+    )
+    answers = work / "traceback_results.json"
+    subprocess.run(
+        [sys.executable, str(DRIVER), str(listed), str(answers)], check=True, timeout=600
+    )
+    return json.loads(answers.read_text())
+
+
+@pytest.mark.parametrize("case_id", list(TRACEBACK_CASES))
+def test_once_a_traceback(case_id: str, traceback_results, work: Path) -> None:
+    case = TRACEBACK_CASES[case_id]
+    result = traceback_results[case_id]
+    _check(case, result["code"], result["stdout"], result["stderr"], result["escaped"], work)
+    if case.code:
+        assert result["stderr"] == f"Error: {case.names}\n"

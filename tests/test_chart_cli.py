@@ -186,3 +186,67 @@ def test_the_depths_are_banded_around_the_draught(draught_m: float) -> None:
     assert shallow.any() and (~shallow).any()
     assert {c for c, s in zip(colours, shallow, strict=True) if s} <= set(SHALLOW_COLOURS)
     assert {c for c, s in zip(colours, shallow, strict=True) if not s} <= set(DEEP_COLOURS)
+
+
+def test_the_summary_lists_the_charted_channels() -> None:
+    result = _run("chart", str(ENC))
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    start = lines.index(
+        "Channels: 20 area(s), 4 line(s) (axis true; least depth; length × mean width)"
+    )
+    listed = lines[start + 1 : start + 25]
+    assert (
+        "  fairway           Annapolis Harbor Channel: centreline 063.6°, two-way, 1281 m × 31 m"
+        in listed
+    )
+    assert (
+        "  dredged-area      Spa Creek Channel: centreline 040.4°, 4.1 m deep, 536 m × 30 m"
+        in listed
+    )
+    assert "  navigation-line   NAVLNE 022610C3897F15B3: line 090.0°, 2161 m" in listed
+    assert sum(line.startswith("  fairway ") for line in listed) == 10
+
+
+def test_a_chart_without_channels_says_so_in_one_line(tmp_path: Path) -> None:
+    from colregs9_cli.charts.water import load_chart
+    from colregs9_cli.jobs.chartinfo import format_chart_summary
+
+    path = _geojson(tmp_path / "plain.geojson", OBJL="DEPARE", DRVAL1=5.0)
+    result = _run("chart", str(path))
+    assert result.exit_code == 0, result.output
+    assert result.output == format_chart_summary(load_chart([path])) + "Channels: none charted\n"
+
+
+def test_the_geopackage_has_the_channels_and_their_axes(tmp_path: Path) -> None:
+    import pyogrio
+    import shapely
+
+    out = tmp_path / "annapolis.gpkg"
+    result = _run("chart", str(ENC), "--draught", "2", "--out", str(out), "--quiet")
+    assert result.exit_code == 0, result.output
+    assert "navigable for 2 m along 100% of its axis, 30 m wide there" in result.output
+    layers = dict(pyogrio.list_layers(out))
+    assert layers["channels"] == "Unknown" and layers["channel_axes"] == "MultiLineString"
+    meta, _, wkb, fields = pyogrio.raw.read(out, layer="channels")
+    columns = dict(zip(meta["fields"], fields, strict=True))
+    assert len(wkb) == 24 and meta["crs"] == "EPSG:4326"
+    kinds = {str(shapely.from_wkb(w).geom_type) for w in wkb}
+    assert kinds == {"MultiPolygon", "MultiLineString"}
+    named = sorted(
+        n for n, k in zip(columns["name"], columns["kind"], strict=True) if n and k == "fairway"
+    )
+    assert named == ["Annapolis Harbor Channel", "Back Creek Channel", "Spa Creek Channel"]
+    assert pyogrio.read_info(out, layer="channel_axes")["features"] == 24
+
+
+def test_a_channel_attribute_that_is_not_a_number(tmp_path: Path) -> None:
+    path = tmp_path / "bad_orient.geojson"
+    depth = {"type": "Feature", "properties": {"OBJL": "DEPARE", "DRVAL1": 5.0}}
+    fairway = {"type": "Feature", "properties": {"OBJL": "FAIRWY", "ORIENT": "NE"}}
+    ring = [[9.9, 57.0], [9.95, 57.0], [9.95, 57.05], [9.9, 57.0]]
+    features = [
+        {**f, "geometry": {"type": "Polygon", "coordinates": [ring]}} for f in (depth, fairway)
+    ]
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": features}))
+    _one_error_line(_run("chart", str(path)), "bad_orient.geojson", "ORIENT is 'NE'")

@@ -49,7 +49,14 @@ def geopackage(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_every_layer_is_there_in_wgs84(geopackage: Path) -> None:
     layers = {str(name): kind for name, kind in pyogrio.list_layers(geopackage)}
-    assert set(layers) == {"depth_areas", "coverage", "land", "navigable_water"}
+    assert set(layers) == {
+        "depth_areas",
+        "coverage",
+        "land",
+        "navigable_water",
+        "channels",
+        "channel_axes",
+    }
     for layer in layers:
         info = pyogrio.read_info(geopackage, layer=layer)
         assert info["crs"] == "EPSG:4326"

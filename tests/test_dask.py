@@ -3,18 +3,33 @@ number of workers, and clear errors."""
 
 from __future__ import annotations
 
+import functools
+import math
 import operator
 import os
+import pickle
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
 import pyogrio
 import pytest
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
 from colregs9_cli.jobs import dask_run
+from colregs9_cli.jobs.ingest import ingest
+from colregs9_cli.jobs.replay import REPLAY_COLUMNS, run_params
+from colregs9_cli.jobs.replay_input import (
+    ReadCounts,
+    ReplayInput,
+    open_replay_input,
+    segment_input_part,
+)
+from colregs9_cli.progress import progress_bar
+from colregs9_cli.query import everything_query
 
 from fixture_files import NMEA
 
@@ -23,7 +38,8 @@ def _replay(out: Path, *options: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [
             *(sys.executable, "-m", "colregs9_cli", "replay", str(NMEA), "--quiet"),
-            *("--out", str(out), "--slab-minutes", "1", *options),
+            # Every ellipse, so that the layer is compared (no chart: none is "restricted").
+            *("--out", str(out), "--slab-minutes", "1", "--domains", "all", *options),
             # Two own ships: four seats, a few figures drawn on the workers.
             *("--own-mmsi", "211356520", "--own-mmsi", "211558470"),
         ],
@@ -161,3 +177,42 @@ def test_settling_waits_for_the_tasks_that_run(tmp_path: Path) -> None:
         assert (tmp_path / "running").read_text() == "late"
         time.sleep(0.3)
         assert not (tmp_path / "queued").exists()
+
+
+def test_a_worker_reads_its_part_of_a_dataset_itself(tmp_path: Path) -> None:
+    """Stage 1 on a LocalCluster of two: each task carries the dataset's place and a range
+    of MMSIs, not positions (pickled, a small share of the positions' bytes), and the
+    worker reads them from the dataset: the client's parts have read nothing, and the
+    workers' results are those of one process reading the whole dataset."""
+    ingest([NMEA], tmp_path / "dataset")
+    query = everything_query()
+    params = run_params(query).replay
+
+    def opened() -> ReplayInput:
+        return open_replay_input(
+            [tmp_path / "dataset"], query, None, True, tmp_path, params.slab_s, REPLAY_COLUMNS
+        )
+
+    whole = opened()
+    (tmp_path / "one").mkdir()
+    alone = whole.merge([segment_input_part(whole, 0, tmp_path / "one", params)])
+    parts = opened().parts(2)
+    assert len(parts) == 2
+    (tmp_path / "two").mkdir()
+    tasks = [
+        functools.partial(segment_input_part, part, k, tmp_path / "two", params)
+        for k, part in enumerate(parts)
+    ]
+    positions_bytes = sum(frame.memory_usage(deep=True).sum() for _, frame in opened().positions())
+    sent_bytes = [len(pickle.dumps(task)) for task in tasks]
+    assert max(sent_bytes) < positions_bytes / 20, (sent_bytes, positions_bytes)
+    with dask_run.dask_client(2, None, tmp_path) as client, progress_bar("", 2, False) as bar:
+        done = dask_run.dask_segments(client, tasks, bar)
+    assert all(part.counts == ReadCounts() for part in parts)  # read on the workers only
+    assert sum(part.counts.kept for part in done) == whole.counts.kept > 20_000
+    merged = opened().merge(done)
+    assert merged.stats == alone.stats
+    assert np.array_equal(merged.vessels, alone.vessels)
+    pd.testing.assert_frame_equal(merged.statics, alone.statics)
+    everything = (-math.inf, math.inf)
+    pd.testing.assert_frame_equal(merged.spill.read(*everything), alone.spill.read(*everything))

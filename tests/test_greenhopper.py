@@ -458,3 +458,15 @@ def test_mean_draught_target_on_the_modelled_chart(demo: DemoRun, tmp_path: Path
     )
     assert clear.outcome.summary.target_estimated_restricted is Restriction.NOT_RESTRICTED
     assert clear.outcome.summary.automaton_path == "D1>D2>D3>D1"
+
+
+def test_the_case_study_rule_9_is_clause_b_with_the_dredged_channel(demo: DemoRun) -> None:
+    """The modelled chart's dredged channel is a charted channel: the target proceeds along
+    it, and the Greenhopper, 11 m, shall not impede her (rule 9(b)); where the target is not
+    restricted rule 9 does not decide, and the outcomes stay the paper's."""
+    restricted = _encounters(demo, "greenhopper_restricted").iloc[0]
+    assert restricted["rule9_clause"] == "9(b)"
+    assert restricted["target_channel_relation"] == "along"
+    assert restricted["own_channel"] == ""  # she waits to cross, outside it
+    clear = _encounters(demo, "greenhopper_not_restricted").iloc[0]
+    assert clear["rule9_clause"] == "" and clear["rule9_applied"] == "false"

@@ -257,17 +257,41 @@ def stats_report(tmp_path_factory: pytest.TempPathFactory):
 
 def test_the_sandiego_page_shows_every_figure_scrolled_through(browser, sandiego_report) -> None:
     result, out = sandiego_report
-    figures = len(result.encounters)
-    assert figures == len(list((out / ENCOUNTER_DIR).glob("*.png"))) == 38
+    # Per encounter: its map, and its range and relative motion.
+    figures = 2 * len(result.encounters)
+    assert figures == len(list((out / ENCOUNTER_DIR).glob("*.png"))) == 2 * 38
     assert_all_shown(see(browser, out / "index.html"), figures)
+
+
+def test_every_encounter_has_its_timeline_on_the_page(browser, sandiego_report) -> None:
+    """A timeline per encounter (and so per triggered pair), each seen in the window when its
+    section is scrolled to, with the trigger and the least separation marked."""
+    result, out = sandiego_report
+    page, log = open_page(browser, out / "index.html")
+    pairs_with_a_timeline = set()
+    for outcome in result.encounters:
+        s = outcome.summary
+        table = page.locator(f'section[id="enc-{s.encounter_id}"] table.timeline')
+        table.scroll_into_view_if_needed()
+        assert table.is_visible()
+        # The whole width in the window: no column behind a scroll bar.
+        assert table.evaluate("t => t.getBoundingClientRect().right <= window.innerWidth")
+        events = table.locator("tr.event").all_inner_texts()
+        assert any("trigger" in row for row in events)
+        if s.actual_min_separation_m is not None:
+            assert any(f"least separation {s.actual_min_separation_m:.0f} m" in r for r in events)
+        pairs_with_a_timeline.add(s.pair_id)
+    assert pairs_with_a_timeline == {p.summary.pair_id for p in result.pairs}
+    assert log["errors"] == []
+    page.context.close()
 
 
 def test_each_demo_page_shows_its_figures(browser, demo_report) -> None:
     pages = sorted(demo_report.out_dir.glob("*/index.html"))
     assert [p.parent.name for p in pages] == sorted(v.scenario for v in demo_report.verdicts)
     for verdict in demo_report.verdicts:
-        figures = len(verdict.replay.encounters)
-        assert figures >= 1
+        figures = 2 * len(verdict.replay.encounters)
+        assert figures >= 2
         assert_all_shown(see(browser, verdict.replay.out_dir / "index.html"), figures)
 
 
@@ -287,7 +311,7 @@ def test_a_figure_is_shown_when_its_link_in_the_table_is_followed(browser, sandi
     page, log = open_page(browser, out / "index.html")
     page.locator(f'#encounters a[href="#enc-{last}"]').click()
     assert page.evaluate("location.hash") == f"#enc-{last}"
-    figure = page.locator(f'section[id="enc-{last}"] img.figure')
+    figure = page.locator(f'section[id="enc-{last}"] img.figure').first
     # No scrolling but the link's: the figure is in the window where the link leads.
     _settle(page)
     assert figure.evaluate("img => img.complete && img.naturalWidth > 0")
@@ -311,11 +335,11 @@ def test_a_missing_figure_is_marked_on_its_own_error(browser, sandiego_report, t
     # At the load event nothing is marked yet: the lazy figure has not been asked for.
     page, _ = open_page(browser, copy / "index.html")
     assert page.locator(".missing").count() == 0
-    assert page.locator("img.figure").count() == len(result.encounters)
+    assert page.locator("img.figure").count() == 2 * len(result.encounters)
     page.context.close()
     seen = see(browser, copy / "index.html")
     assert seen.missing_notes == [f"figure not found: {last}"]
-    assert seen.figures == len(result.encounters) - 1
+    assert seen.figures == 2 * len(result.encounters) - 1
     assert len(seen.shown) == seen.figures and not seen.not_loaded
     assert seen.dead_links == [last]
     # Chromium logs the file it could not read; nothing else.

@@ -175,8 +175,27 @@ def test_tugs_in_company_turning_together() -> None:
     )
     found = classify_interaction(pair_series(own, target), 180, tugs, PARAMS, 1.0)
     assert found.kind is KIND.IN_COMPANY
-    assert found.basis.startswith("range 60–80 m, relative position within ")
+    # the target keeps her place on own ship's beam as it turns: in the frame of the course
+    assert found.basis.startswith("range 60–80 m, relative position along the course within ")
     assert found.basis.endswith("for 240 s")
+
+
+def test_ships_abreast_turning_together_keep_their_places_over_ground() -> None:
+    # Two tugs 70 m abreast at 6 kn turn 40° together, each on the spot: their relative
+    # position stays put over ground, while in the frame of their course it swings by
+    # 2 · 70 · sin(20°) = 48 m, more than company_drift_m.
+    seconds = np.arange(361)
+    course = np.radians(np.where(seconds < 120, 0.0, np.minimum(40.0, (seconds - 120) * 0.25)))
+    heading = np.c_[np.cos(course), np.sin(course)]
+    own = np.cumsum(heading * 6.0 * MPS_PER_KNOT, axis=0)
+    target = own + np.array([0.0, 70.0])
+    tugs = (
+        VesselFacts(1, "Tug", "Class A", 30.0, 10.0),
+        VesselFacts(2, "Tug", "Class A", 30.0, 10.0),
+    )
+    found = classify_interaction(pair_series(own, target), 180, tugs, PARAMS, 1.0)
+    assert found.kind is KIND.IN_COMPANY
+    assert found.basis.startswith("range 70 m, relative position over ground within 0 m ")
 
 
 def test_a_slow_overtaking_on_the_same_course_stays_an_encounter() -> None:

@@ -18,7 +18,7 @@ from colregs9_cli.core.rows import ENCOUNTER_COLUMNS, SERIES_COLUMNS
 from colregs9_cli.jobs.replay import run_replay
 from colregs9_cli.jobs.simulate import simulate_scenario
 from colregs9_cli.report.chart_plot import DEPTH_LABEL, RESTRICTED_COLOUR
-from colregs9_cli.report.replay_report import (
+from colregs9_cli.report.encounter_figure import (
     OUTLINES_PER_ARC,
     direction_arrows,
     encounter_figure,

@@ -17,8 +17,8 @@ from matplotlib.text import Text
 
 from colregs9_cli.charts.water import load_chart
 from colregs9_cli.report.chart_plot import NOT_CHARTED_LABEL
+from colregs9_cli.report.encounter_figure import DEFAULTED_NOTE, encounter_figure
 from colregs9_cli.report.html_report import overview_figure, pair_numbers, place_labels
-from colregs9_cli.report.replay_report import DEFAULTED_NOTE, encounter_figure
 
 from fixture_files import SANDIEGO_ENC
 

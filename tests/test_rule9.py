@@ -322,3 +322,43 @@ def test_every_pair_verdict_is_consistent(
     assert verdict.rule9_applied is (verdict.deciding_rule is R9)
     mirrored = decide_pair(situation, roles[::-1], (nav_b, nav_a), (estimate_b, estimate_a))
     assert mirrored == swapped(verdict)
+
+
+# -- which clause of rule 9, with the chart's channels --------------------------------------
+
+
+def _standing(**flags: bool):
+    from colregs9_cli.core.rule9 import ChannelStanding
+
+    names = ("along_channel", "crossing_channel", "small_or_sailing", "fishing")
+    values = dict.fromkeys(names, False)
+    return ChannelStanding(**{**values, **flags})
+
+
+@pytest.mark.parametrize(
+    ("restricted", "other", "clause"),
+    [
+        # a deep-draught ship along the channel; a yacht crossing it: 9(d) before 9(b)
+        ({"along_channel": True}, {"crossing_channel": True, "small_or_sailing": True}, "9(d)"),
+        ({"along_channel": True}, {"small_or_sailing": True}, "9(b)"),
+        ({"along_channel": True}, {"fishing": True}, "9(c)"),
+        # two ships along the channel: 9(b)-(d) do not invert rules 13-15
+        ({"along_channel": True}, {"along_channel": True}, "none"),
+        # no charted channel where she is: the estimator alone, as in the paper
+        ({}, {"small_or_sailing": True}, "estimator"),
+        ({"crossing_channel": True}, {"along_channel": True}, "estimator"),
+    ],
+)
+def test_the_clause_of_rule_9_that_binds_the_other_vessel(restricted, other, clause) -> None:
+    from colregs9_cli.core.rule9 import rule9_clause
+
+    assert rule9_clause(_standing(**restricted), _standing(**other)).value == clause
+
+
+def test_sandiego_names_the_clause_where_rule_9_decided(sandiego_replay) -> None:
+    # SHELTER ISLAND, a 9 m yacht the estimator finds restricted outside any charted
+    # channel; WHITE NIGHTS, proceeding along the main channel, gives way to her.
+    summaries = [p.summary for p in sandiego_replay.pairs]
+    applied = [s for s in summaries if s.rule9_applied]
+    assert [(s.name_a, s.rule9_clause.value) for s in applied] == [("SHELTER ISLAND", "estimator")]
+    assert all(s.rule9_clause is None for s in summaries if not s.rule9_applied)

@@ -85,7 +85,14 @@ def test_report_geopackage_opens_with_every_layer(sandiego) -> None:
 
     path = sandiego.out_dir / "report.gpkg"
     layers = {str(name) for name, kind in pyogrio.list_layers(path) if kind}
-    assert layers == {"encounters", "tracks", "cpa", "domains", "navigable_water"}
+    assert layers == {
+        "encounters",
+        "tracks",
+        "cpa",
+        "domains",
+        "navigable_water",
+        "vessel_tracks",
+    }
     # the QGIS styles, an attribute table beside them
     assert {str(name) for name, kind in pyogrio.list_layers(path) if not kind} == {"layer_styles"}
     for layer in layers:

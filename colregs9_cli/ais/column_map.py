@@ -43,6 +43,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from ..config import TOO_DEEP
 from ..errors import ParameterError
 from .layouts import LAYOUTS, MAP_PREFIX, Layout
 from .schema import ANTENNA_OFFSETS, CANONICAL_COLUMNS
@@ -176,6 +177,10 @@ def map_layout(path: Path) -> str:
 @functools.lru_cache(maxsize=16)
 def load_column_map(path: Path) -> ColumnMap:
     """Read and check a map file; ``ParameterError`` naming the file and the key."""
+    if path.exists() and not (path.is_file() or path.is_dir()):  # a pipe's read would block
+        raise ParameterError(
+            f"--columns {path}: a pipe or a device, not a file; give the map's TOML file"
+        )
     try:
         text = path.read_bytes().decode("utf-8")
     except FileNotFoundError:
@@ -192,6 +197,12 @@ def load_column_map(path: Path) -> ColumnMap:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParameterError(f"{path}: not valid TOML ({exc}); fix the map") from None
+    except RecursionError:
+        raise ParameterError(f"{path}: {TOO_DEEP}; fix the map") from None
+    except ValueError:  # an integer of more digits than Python converts
+        raise ParameterError(
+            f"{path}: a number of more than 4300 digits; give numbers of a sensible size"
+        ) from None
     return _parse_map(path, data)
 
 

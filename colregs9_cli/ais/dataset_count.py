@@ -6,7 +6,9 @@ A query of everything reads the dataset once: every row, position or static repo
 counted with a flag saying whether it has a position, and both counts come from those
 groups. Any other query reads it twice: the positions in the query, pushed down into the
 scan (``dataset_scan.position_filter``), then every row of the vessels found, at any time
-and place, as the reports of a file are counted.
+and place, as the reports of a file are counted. Either way the vessels' dimension reports
+that an ingest query left out of the dataset (``Dataset.outside_query_reports``) are added,
+so that they are those of the files.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from .dataset_scan import (
     reports_filter,
     scan_columns,
 )
+from .dimension_reports import sum_counts
 from .schema import CANONICAL_COLUMNS, STATS_POSITION_COLUMNS, canonical_fields
 
 REPORT_COLUMNS: tuple[str, ...] = ("mmsi", *DIMENSIONS)
@@ -41,7 +44,8 @@ class DatasetCounts:
     ``position_counts``: ``STATS_POSITION_COLUMNS`` and ``n_positions``, how many positions
     in the query have them. ``report_counts``: ``REPORT_COLUMNS`` and ``n_reports``, how
     many rows (positions and static reports) of the vessels with a position in the query
-    have them, with the dimensions as stored.
+    have them, with the dimensions as stored, and how many of their rows outside the ingest
+    query did.
     """
 
     position_counts: pa.Table
@@ -63,12 +67,22 @@ def count_dataset(dataset: Dataset, query: Query) -> DatasetCounts:
 
 def count_reports(dataset: Dataset, vessels: Sequence[int]) -> pa.Table:
     """``DatasetCounts.report_counts`` of ``vessels``: every row of theirs, positions and
-    static reports, at any time and place, counted by ``REPORT_COLUMNS``."""
+    static reports, at any time and place, counted by ``REPORT_COLUMNS``, with their
+    reports outside the ingest query."""
     reports = RowCounts(canonical_fields(REPORT_COLUMNS), "n_reports")
     if len(vessels):
         for table in dataset.scan(reports_filter(vessels), REPORT_COLUMNS):
             reports.add(table)
-    return reports.finish()
+    return _with_outside(dataset, reports.finish(), vessels)
+
+
+def _with_outside(dataset: Dataset, counts: pa.Table, vessels: Sequence[int]) -> pa.Table:
+    """``counts`` of ``vessels``' reports with those their ingest queries left out, sorted."""
+    outside = dataset.outside_query_reports(vessels)
+    if outside.num_rows == 0:
+        return counts
+    summed = sum_counts([counts, outside])
+    return summed.sort_by([(key, "ascending") for key in REPORT_COLUMNS])
 
 
 def _count_everything(dataset: Dataset) -> DatasetCounts:
@@ -86,9 +100,11 @@ def _count_everything(dataset: Dataset) -> DatasetCounts:
     groups = rows.finish()
     positioned = groups.filter(groups.column(_HAS_POSITION))
     position_counts = _summed(positioned, STATS_POSITION_COLUMNS, "n_positions")
-    of_vessels = pc.is_in(groups.column("mmsi"), value_set=pc.unique(positioned.column("mmsi")))
+    vessels = pc.unique(positioned.column("mmsi"))
+    of_vessels = pc.is_in(groups.column("mmsi"), value_set=vessels)
     report_counts = _summed(groups.filter(of_vessels), REPORT_COLUMNS, "n_reports")
-    return DatasetCounts(position_counts, report_counts)
+    outside = _with_outside(dataset, report_counts, vessels.to_pylist())
+    return DatasetCounts(position_counts, outside)
 
 
 def _summed(groups: pa.Table, keys: Sequence[str], name: str) -> pa.Table:

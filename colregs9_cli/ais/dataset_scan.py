@@ -10,11 +10,17 @@ it. The scans are ``pyarrow.dataset`` scans with the query pushed down: the time
 prunes partitions and, with the region, row groups by their statistics; only the columns
 asked for are decoded.
 
-Format versions: 2 has the canonical schema with AIS's A, B, C, D (``to_bow_m`` ...); 1, from
-before, lacks those four columns. A version 1 dataset, or a version 2 one holding inputs
-ingested as version 1 (an ingest into a version 1 dataset upgrades its manifest), is read
-with the four null for those inputs' rows: the scans fill a column a file lacks with nulls.
-Re-ingesting its inputs gives them their A, B, C, D.
+Format versions: 3 adds to each input ingested through a query the dimension reports of its
+rows that the query left out (``_dimension_reports/part-<sha16>.parquet``, listed in the
+manifest as ``outside_query_reports``: counts by MMSI, length, breadth and draught, as
+``dimension_reports`` counts them), which ``stats`` adds to those of the rows the dataset
+holds, so that a vessel's dimensions do not depend on the ingest query; 2 has the canonical
+schema with AIS's A, B, C, D (``to_bow_m`` ...); 1, from before, lacks those four columns. An
+input of version 1 or 2 has no such reports (re-ingest it to have them). A version 1
+dataset, or a later one holding inputs ingested as version 1 (an ingest into an older
+dataset upgrades its manifest), is read with the four null for those inputs' rows: the
+scans fill a column a file lacks with nulls. Re-ingesting its inputs gives them their A, B,
+C, D.
 
 Used by ``load.load_ais`` (so a dataset is accepted wherever AIS files are) and by
 ``dataset.py``; it imports neither.
@@ -32,21 +38,28 @@ from typing import Any
 
 import pyarrow as pa
 import pyarrow.dataset as ds
+import pyarrow.parquet as pq
 
 from ..errors import InputFileError
 from ..query import Query, ms_at_or_after
+from .dimension_reports import NO_REPORTS
 from .ledger import RejectsLedger
 from .query_rows import rows_in_query
 from .schema import ANTENNA_OFFSETS, CANONICAL_COLUMNS, CANONICAL_SCHEMA
 
 MANIFEST_NAME = "colregs9-dataset.json"
 DATASET_FORMAT = "colregs9-dataset"
-FORMAT_VERSION = 2
-# The schema of the files of each format version: 1 had no A, B, C, D.
+FORMAT_VERSION = 3
+# The schema of the files of each format version: 1 had no A, B, C, D; 3 added the
+# dimension reports outside the ingest query, in files of their own.
 FILE_SCHEMAS: dict[int, pa.Schema] = {
     1: pa.schema([f for f in CANONICAL_SCHEMA if f.name not in ANTENNA_OFFSETS]),
+    2: CANONICAL_SCHEMA,
     FORMAT_VERSION: CANONICAL_SCHEMA,
 }
+# Where an input's dimension reports outside its ingest query go, and their schema.
+REPORTS_DIR = "_dimension_reports"
+REPORTS_SCHEMA = NO_REPORTS.schema
 PARTITION_FIELD = pa.field("date", pa.date32())
 # The hive convention for a null partition value (Spark, DuckDB and polars read it so too).
 UNDATED = "__HIVE_DEFAULT_PARTITION__"
@@ -105,12 +118,16 @@ class DatasetInput:
     files: tuple[DatasetFile, ...]
     entry: dict[str, Any]
     format_version: int = FORMAT_VERSION
+    # The file of its dimension reports outside the ingest query (``REPORTS_DIR``), if any.
+    outside_query_reports: DatasetFile | None = None
 
 
 def read_manifest(directory: Path) -> list[DatasetInput]:
     """The inputs the dataset manifest in ``directory`` lists, checked; ``InputFileError``
     for a missing, unreadable or malformed manifest."""
     path = Path(directory) / MANIFEST_NAME
+    if path.exists() and not path.is_file():  # a pipe's read would block
+        raise InputFileError(f"{path}: not a file; restore the dataset manifest, or {_REMEDY}")
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -127,6 +144,10 @@ def read_manifest(directory: Path) -> list[DatasetInput]:
     except ValueError as exc:
         raise InputFileError(
             f"{path}: the dataset manifest is not valid JSON ({exc}); restore it, or {_REMEDY}"
+        ) from None
+    except RecursionError:  # JSON nested thousands deep, which no manifest is
+        raise InputFileError(
+            f"{path}: the manifest is nested too deeply to be one; restore it, or {_REMEDY}"
         ) from None
     if not isinstance(manifest, dict) or manifest.get("format") != DATASET_FORMAT:
         raise InputFileError(f"{path}: not a colregs9 dataset manifest; {_REMEDY}")
@@ -183,7 +204,17 @@ def _input(entry: dict[str, Any], manifest_version: int) -> DatasetInput:
         files=files,
         entry=entry,
         format_version=version,
+        outside_query_reports=_listed_reports(entry, version),
     )
+
+
+def _listed_reports(entry: dict[str, Any], version: int) -> DatasetFile | None:
+    """The file of an input's dimension reports outside its ingest query, as its manifest
+    entry lists it (format version 3 on; null where the query left none out)."""
+    listed = entry["outside_query_reports"] if version >= 3 else None
+    if listed is None:
+        return None
+    return DatasetFile(str(listed["path"]), None, int(listed["rows"]))
 
 
 @dataclass(frozen=True)
@@ -242,6 +273,9 @@ class Dataset:
                 arrow.get_fragments(), listed, versions, strict=True
             )
         )
+        for item in inputs:
+            if item.outside_query_reports is not None:
+                _check_reports(directory, item.outside_query_reports)
         return cls(directory, inputs, arrow, static_rows)
 
     @property
@@ -262,6 +296,22 @@ class Dataset:
         and duplicates share their timestamp, hence their partition."""
         dates = [{f.date for f in item.files if f.date is not None} for item in self.inputs]
         return sum(len(d) for d in dates) == len(set().union(*dates))
+
+    def outside_query_reports(self, vessels: Sequence[int]) -> pa.Table:
+        """The dimension reports of ``vessels`` that the inputs' ingest queries left out of
+        the dataset (``REPORTS_SCHEMA``: counts by MMSI and dimensions, not yet summed
+        across inputs); none from inputs of format version 1 or 2."""
+        tables = [NO_REPORTS]
+        for item in self.inputs:
+            if item.outside_query_reports is not None and len(vessels):
+                path = self.directory / item.outside_query_reports.path
+                try:
+                    tables.append(pq.read_table(path, filters=reports_filter(vessels)))
+                except (pa.ArrowException, OSError) as exc:
+                    raise InputFileError(
+                        f"{path}: cannot read the dimension reports ({exc}); {_REMEDY}"
+                    ) from None
+        return pa.concat_tables(tables)
 
     def ingest_ledger(self) -> RejectsLedger:
         """The ledgers of the inputs, merged: what reading the files themselves counted."""
@@ -342,6 +392,12 @@ def _check_fragment(
     named = "the canonical schema"
     if version != FORMAT_VERSION:
         named = f"the schema of format version {version}"
+    twice = next((name for name in schema.names if schema.names.count(name) > 1), None)
+    if twice is not None:
+        raise InputFileError(
+            f"{path}: has the column {twice!r} {schema.names.count(twice)} times; not a file "
+            f"of this dataset: move it out, or {_REMEDY}"
+        )
     for expected in expected_schema:
         if expected.name not in schema.names:
             raise InputFileError(
@@ -372,6 +428,27 @@ def _check_fragment(
             return int(fragment.count_rows(filter=ds.field("lat_deg").is_null()))
         static += stats.null_count
     return static
+
+
+def _check_reports(directory: Path, listed: DatasetFile) -> None:
+    """An input's dimension reports outside its ingest query: there, with their schema and
+    the rows the manifest lists (from the footer)."""
+    path = directory / listed.path
+    if not path.is_file():
+        raise InputFileError(f"{path}: listed in the dataset manifest but missing; {_REMEDY}")
+    try:
+        metadata = pq.read_metadata(path)
+    except (pa.ArrowException, OSError) as exc:
+        raise InputFileError(f"{path}: not a readable Parquet file ({exc}); {_REMEDY}") from None
+    if not metadata.schema.to_arrow_schema().equals(REPORTS_SCHEMA):
+        raise InputFileError(
+            f"{path}: not the dimension reports of this dataset (columns "
+            f"{', '.join(REPORTS_SCHEMA.names)}); move it out, or {_REMEDY}"
+        )
+    if metadata.num_rows != listed.rows:
+        raise InputFileError(
+            f"{path}: holds {metadata.num_rows} rows, the manifest lists {listed.rows}; {_REMEDY}"
+        )
 
 
 def scan_columns(wanted: Sequence[str], query: Query, ordered: bool = True) -> tuple[str, ...]:

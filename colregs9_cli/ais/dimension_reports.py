@@ -2,8 +2,9 @@
 the ``dimension_reports`` of ``load.AisData`` (what counts as a report: load.py's docstring).
 
 Counted block by block as rows are read (``count_reports``), from a dataset's stored counts
-(``cleaned_reports``), summed into one row per combination (``sum_counts``), and taken back
-for rows rejected later (``subtract_counts``).
+(``cleaned_reports``), summed into one row per combination (``sum_counts``), taken back for
+rows rejected later (``subtract_counts``), and counted from cleaned canonical rows
+(``rows_reports``).
 """
 
 from __future__ import annotations
@@ -54,6 +55,10 @@ def report_rows(
             "n_reports": pa.array(np.ones(len(mmsi)) if times is None else times, pa.int64()),
         }
     )
+
+
+# No report, with the columns and types of ``report_rows``.
+NO_REPORTS = report_rows(np.empty(0), np.empty(0), np.empty(0), np.empty(0))
 
 
 def sum_counts(parts: Sequence[pa.Table]) -> pa.Table:
@@ -115,18 +120,21 @@ def cleaned_reports(groups: pa.Table) -> pa.Table:
 
 def subtract_counts(counts: pa.Table, dropped: pa.Table) -> pa.Table:
     """``counts`` less the dimension reports of the ``dropped`` rows."""
-    length_m, breadth_m, draught_m = (to_numpy_float(dropped.column(d)) for d in DIMENSIONS)
+    return sum_counts([counts, rows_reports(dropped, -1)])
+
+
+def rows_reports(rows: pa.Table, times: int = 1) -> pa.Table:
+    """The dimension reports (``report_rows``) of canonical ``rows``, whose dimensions are
+    cleaned already, each counting ``times``; rows that report none are left out."""
+    length_m, breadth_m, draught_m = (to_numpy_float(rows.column(d)) for d in DIMENSIONS)
     reported = any_dimension(length_m, breadth_m, draught_m)
-    if not reported.any():
-        return counts
-    removed = report_rows(
-        dropped.column("mmsi").to_numpy()[reported],
+    return report_rows(
+        rows.column("mmsi").to_numpy()[reported],
         length_m[reported],
         breadth_m[reported],
         draught_m[reported],
-        times=np.full(int(reported.sum()), -1),
+        times=np.full(int(reported.sum()), times),
     )
-    return sum_counts([counts, removed])
 
 
 def reports_frame(counts: pa.Table, vessels: np.ndarray) -> pd.DataFrame:

@@ -53,6 +53,8 @@ class RejectsLedger:
     # Rows by the source of their time, where a layout has several (NMEA: nmea.TimeSource).
     time_sources: Counter[str] = field(default_factory=Counter)
     time_source_order: tuple[str, ...] = ()  # the precedence the reader used
+    # How NMEA messages found their $PGHP line (nmea_pghp.Pairing), in logs that have any.
+    pghp_pairing: Counter[str] = field(default_factory=Counter)
     # Examples of rejected rows, for the manifest: reason -> a few "file:line: value" strings.
     examples: dict[str, list[str]] = field(default_factory=dict)
     max_examples: int = 5
@@ -103,6 +105,7 @@ class RejectsLedger:
             self.rejects[reason] += count
         self.time_sources.update(part.time_sources)
         self.time_source_order = self.time_source_order or part.time_source_order
+        self.pghp_pairing.update(part.pghp_pairing)
         self.dropped.update(part.dropped)
         for mine, theirs in (
             (self.examples, part.examples),
@@ -123,6 +126,7 @@ class RejectsLedger:
             rejects=Counter({str(k): int(v) for k, v in data["rejects_by_reason"].items()}),
             time_sources=Counter({str(k): int(v) for k, v in data.get("time_sources", {}).items()}),
             time_source_order=tuple(str(s) for s in data.get("time_source_order", ())),
+            pghp_pairing=Counter({str(k): int(v) for k, v in data.get("pghp_pairing", {}).items()}),
             examples={str(k): [str(e) for e in v] for k, v in data["reject_examples"].items()},
             dropped=Counter({str(k): int(v) for k, v in data.get("values_dropped", {}).items()}),
             dropped_examples={
@@ -156,6 +160,11 @@ class RejectsLedger:
                     "time_source_order": list(self.time_source_order),
                 }
                 if self.time_sources
+                else {}
+            ),
+            **(
+                {"pghp_pairing": dict(sorted(self.pghp_pairing.items()))}
+                if self.pghp_pairing
                 else {}
             ),
             **(

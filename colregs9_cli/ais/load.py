@@ -50,12 +50,18 @@ parsed again with every column as text, and a chunk with a malformed row again o
 thread, which gives the row's line; the rest of the file is not affected. NMEA is decoded
 whole per file (see nmea.py).
 
+Of several NMEA files (a log split by day), the positions of each take the static fields
+they still lack from the static messages of all (static_join.py), as ``colregs9 ingest``
+does, and their dimension reports change with them; so each file of a load of several hands
+its rows to a sink (``_KeptRows``) that keeps its static reports too.
+
 ``stream_ais`` reads one file the same way but hands its rows on block by block (a
 ``row_pipeline.RowSink``), static reports converted too, instead of keeping them:
 ``colregs9 ingest`` (dataset.py) writes them to a Parquet dataset. ``load_ais`` reads such a
 dataset in place of files (``inputs.read_dataset``): its rows were cleaned at ingest, so only
 the query is applied, pushed down into the scan (dataset_scan.py), and the dimension reports
-of the vessels in the query are counted over the whole dataset, as over a whole file.
+of the vessels in the query are counted over the whole dataset, with those of the rows its
+ingest query left out (``dataset_count.count_reports``), as over a whole file.
 
 ``count_ais`` reads as ``load_ais`` does but gives the positions as counts of their MMSI,
 ship type and dimensions, all that the dimension statistics use; a dataset read alone is
@@ -81,9 +87,10 @@ from ..vessels import DIMENSIONS
 from .counting import RowCounts
 from .csv_read import CsvReading
 from .dimension_reports import (
+    NO_REPORTS,
     cleaned_reports,
-    report_rows,
     reports_frame,
+    rows_reports,
     subtract_counts,
     sum_counts,
 )
@@ -98,11 +105,12 @@ from .inputs import (
     open_inputs,
     read_dataset,
 )
-from .layouts import find_layout
+from .layouts import NMEA, find_layout
 from .ledger import RejectReason, RejectsLedger
 from .row_pipeline import FileResult, RowSink
 from .schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA, STATS_POSITION_COLUMNS, canonical_fields
 from .sources import Source
+from .static_join import STATIC_COLUMNS, fill_statics
 
 if TYPE_CHECKING:
     from .dataset_scan import Dataset
@@ -194,6 +202,7 @@ def _load(
         scanned = scan_columns(wanted, query, ordered)
     inputs: list[InputFile] = []
     total_bytes = float(sum(s.size_bytes for s in sources))
+    several = sum(isinstance(s, Source) for s in sources) > 1
     with progress_bar("Reading AIS", total_bytes, progress_enabled(quiet), in_bytes=True) as bar:
         for index, source in enumerate(sources):
             if not isinstance(source, Source):
@@ -202,12 +211,13 @@ def _load(
                 )
                 collected.datasets.append(source)
                 continue
-            part = read_source(
-                source, forced, query, bar, started if index == 0 else None, needs_time=needs_time
-            )
+            sink = _KeptRows() if several else None
+            first = started if index == 0 else None
+            part = read_source(source, forced, query, bar, first, sink, needs_time)
             ledger.merge(part.ledger)
-            collected.extend(part)
+            collected.extend(part, sink)
             inputs.append(InputFile(source.path, part.sha256, part.layout, part.ledger.rows_read))
+    collected.join_nmea_statics()
     positions, dimension_reports = collected.finish(ledger, wanted)
     if positions.num_rows == 0:
         raise no_positions_error(inputs, ledger, query)
@@ -293,11 +303,15 @@ def _counted_dataset(dataset: Dataset, query: Query, quiet: bool) -> CountedAis:
 @dataclass(frozen=True)
 class StreamedInput:
     """What ``stream_ais`` read of one file. ``ledger`` counts every row but the position
-    rows handed to the sink, which the caller is to use, or reject as duplicates."""
+    rows handed to the sink, which the caller is to use, or reject as duplicates.
+    ``dimension_reports``: the file's dimension reports as ``load_ais`` counts them (every
+    vessel's, inside the query or not; duplicates not yet taken back), summed
+    (``dimension_reports.sum_counts``)."""
 
     sha256: str
     layout: str
     ledger: RejectsLedger
+    dimension_reports: pa.Table
 
 
 def stream_ais(
@@ -309,7 +323,24 @@ def stream_ais(
     advances by the bytes read."""
     layout = find_layout(fmt) if fmt is not None else None
     part = read_source(source, layout, query, bar, None, sink)
-    return StreamedInput(part.sha256, part.layout, part.ledger)
+    reports = sum_counts([NO_REPORTS, *part.dimension_parts])
+    return StreamedInput(part.sha256, part.layout, part.ledger, reports)
+
+
+class _KeptRows:
+    """The ``RowSink`` of each file of a load of several: its positions in the query, and
+    its static reports (which a load otherwise only counts), for the join across NMEA
+    files (``_Collected.join_nmea_statics``)."""
+
+    def __init__(self) -> None:
+        self.kept: list[pa.Table] = []
+        self.reports: list[pa.Table] = []
+
+    def positions(self, table: pa.Table) -> None:
+        self.kept.append(table)
+
+    def statics(self, table: pa.Table) -> None:
+        self.reports.append(table.select(list(STATIC_COLUMNS)))
 
 
 @dataclass
@@ -321,11 +352,34 @@ class _Collected:
     # False when the rows cannot hold exact duplicates (``dataset_alone``): none are sought.
     may_repeat: bool = True
     ordered: bool = True
+    # The NMEA files read through a ``_KeptRows``: how many, their tables in ``kept`` (by
+    # index) and their static reports.
+    nmea_files: int = 0
+    nmea_kept: list[int] = field(default_factory=list)
+    nmea_statics: list[pa.Table] = field(default_factory=list)
 
-    def extend(self, part: FileResult) -> None:
-        self.kept.extend(part.kept)
+    def extend(self, part: FileResult, sink: _KeptRows | None = None) -> None:
+        kept = part.kept if sink is None else sink.kept
+        if sink is not None and part.layout == NMEA.name:
+            self.nmea_files += 1
+            self.nmea_kept.extend(range(len(self.kept), len(self.kept) + len(kept)))
+            self.nmea_statics.extend(sink.reports)
+        self.kept.extend(kept)
         if part.dimension_parts:
             self.dimension_parts.append(sum_counts(part.dimension_parts))
+
+    def join_nmea_statics(self) -> None:
+        """Give the positions of each NMEA file the static fields they lack from the static
+        reports of all of them (``static_join``), as an ingest of the files does; their
+        dimension reports change with them."""
+        if self.nmea_files < 2 or not self.nmea_statics:
+            return
+        statics = pa.concat_tables(self.nmea_statics)
+        for index in self.nmea_kept:
+            before = self.kept[index]
+            self.kept[index] = fill_statics(before, statics)
+            changed = [rows_reports(before, -1), rows_reports(self.kept[index])]
+            self.dimension_parts.append(sum_counts(changed))
 
     def finish(self, ledger: RejectsLedger, wanted: Sequence[str]) -> tuple[pa.Table, pd.DataFrame]:
         """Sort, drop exact duplicates (ledger), and count the used rows; the positions with
@@ -341,12 +395,9 @@ class _Collected:
         if reordered:
             rows = pc.sort_indices(table.select(["mmsi", "timestamp"]), ROW_ORDER).to_numpy()
         duplicate = repeated_rows(table, rows) if self.may_repeat else np.zeros(len(rows), bool)
-        empty = np.empty(0)
         vessels = pc.unique(table.column("mmsi")).to_pylist()
         datasets = [dataset_reports(d, vessels) for d in self.datasets if vessels]
-        counts = sum_counts(
-            [report_rows(empty, empty, empty, empty), *self.dimension_parts, *datasets]
-        )
+        counts = sum_counts([NO_REPORTS, *self.dimension_parts, *datasets])
         if duplicate.any():
             dropped = table.select(["mmsi", "timestamp", *DIMENSIONS]).take(rows[duplicate])
             first = canonical_frame(dropped.slice(0, 1).select(["mmsi", "timestamp"])).iloc[0]

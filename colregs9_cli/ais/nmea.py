@@ -4,10 +4,13 @@ Timestamps, kept to the millisecond. A sentence can carry up to three times (``T
 
 - ``tag_block``: a tag block ``c:`` on its own line (``\\s:rORBCOMM,c:1384257600*hh\\!AIVDM,...``)
   or on a stand-alone tag block line just before it: the receiver's time of reception;
-- ``pghp``: a Gatehouse ``$PGHP,1,Y,M,D,h,m,s,ms,...`` line just before it (the DMA feed;
-  satellite feeds write their origin, e.g. ``1AIS_S``, in the fields after the time, and any
-  field after the milliseconds is accepted): the base station's or satellite's time of
-  reception, with milliseconds;
+- ``pghp``: a Gatehouse ``$PGHP,1,Y,M,D,h,m,s,ms,...`` line (the DMA feed, just before it;
+  exactEarth's satellite feeds, near it, with their origin, e.g. ``1AIS_S``, in the fields
+  after the time, and any field after the milliseconds is accepted): the base station's or
+  satellite's time of reception, with milliseconds. Its 14th field is the checksum of the
+  sentence it times, and nmea_pghp.py pairs the two by it (the ``$PGHP`` right before a
+  sentence with its checksum, else the nearest within 15 lines); one without that field
+  times the next sentence;
 - ``arrival``: a trailing ``,<unix time>`` after the checksum: when the line reached the
   archive, which for satellite data is minutes to hours after the observation.
 
@@ -15,23 +18,27 @@ The observation wins over the arrival: by default ``tag_block``, then ``pghp``, 
 ``arrival`` (``DEFAULT_TIME_SOURCES``; ``read_nmea``'s ``time_sources`` changes the order or
 leaves a source out). A whole-second observation time gives way to the other observation
 source's time of the same second with milliseconds (DMA lines carry a ``c:`` in seconds and a
-``$PGHP`` with milliseconds). Each message's source is counted in the ledger (``time_sources``). Any
-sentence line (AIS or not) consumes the pending times, because ``$PGHP`` stamps exactly the
-next sentence. A tag block whose checksum fails gives no time; so does a ``$PGHP`` line whose
-checksum or date fails. ``c:`` and trailing values above 1e11 are taken as milliseconds. A
-message with no time from the sources in use is rejected as unparseable: without a time it
-cannot be placed in a track. A reader that needs no time (``read_nmea``'s ``keep_timeless``:
-``colregs9 stats``, whose dimension statistics need none) keeps such messages with a null
-timestamp and counts them under the time source ``none``; ``NmeaCounts.timeless`` counts them
-either way, so that a caller can tell a log in which no line has a time.
+``$PGHP`` with milliseconds). Each message's source is counted in the ledger
+(``time_sources``), and in a log with ``$PGHP`` lines how it found its ``$PGHP``
+(``pghp_pairing``: ``matched`` by checksum, ``adjacent`` without one, ``unmatched``; and the
+``pghp_unmatched`` lines that timed no sentence). A stand-alone tag block line gives its time
+to the next sentence line only (AIS or not). A tag block whose checksum fails gives no time;
+so does a ``$PGHP`` line whose checksum or date fails. ``c:`` and trailing values above 1e11
+are taken as milliseconds. A message with no time from the sources in use is rejected as
+unparseable: without a time it cannot be placed in a track. A reader that needs no time
+(``read_nmea``'s ``keep_timeless``: ``colregs9 stats``, whose dimension statistics need none)
+keeps such messages with a null timestamp and counts them under the time source ``none``;
+``NmeaCounts.timeless`` counts them either way, so that a caller can tell a log in which no
+line has a time.
 
 Multi-sentence messages are reassembled per (sentence tag, channel, sequential id, fragment
 count), so interleaved messages on other channels or ids do not disturb each other. A group
 must arrive in order 1, 2, ..., n; a gap or a repeat marks the group broken, and a broken or
 unfinished group counts once as ``incomplete_multipart``. Accepting fragments out of order
 would let the tail of an older message complete a newer one with the same recycled id (0-9),
-which decodes into a plausible but wrong message. The message takes the time of its first
-timed fragment and the line number of its first fragment. A sentence that fails its checksum
+which decodes into a plausible but wrong message. The message takes the times of its first
+fragment and of the ``$PGHP`` of the whole message (else the time of its first later fragment
+that has one) and the line number of its first fragment. A sentence that fails its checksum
 is one unparseable row by itself (its fragment header cannot be trusted), so the rest of its
 message then counts as incomplete.
 
@@ -71,9 +78,12 @@ draught beyond ``MAX_DRAUGHT_M``).
 from __future__ import annotations
 
 import re
+from collections import Counter
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
+from functools import lru_cache, reduce
+from operator import xor
 from typing import cast
 
 from pyais.exceptions import AISBaseException
@@ -94,6 +104,7 @@ from pyais.messages import (
 
 from .batch import AisBatch
 from .ledger import RejectReason, RejectsLedger
+from .nmea_pghp import Pairing, Pghp, PghpMatcher
 from .nmea_tables import NO_TIME_MS, POSITION_TYPES, NmeaColumns, nmea_batch
 from .time_sources import DEFAULT_TIME_SOURCES, TimeSource
 
@@ -108,6 +119,9 @@ _TRAILER_SEPARATORS = re.compile(r"[,\s]+")
 
 # A message's time: milliseconds since the epoch, and its source.
 _Stamp = tuple[int, TimeSource]
+# A message waiting for its $PGHP: the sentence (reassembled), its first line, the times of
+# its first sentence, the time of a later fragment, the raw text.
+_MessagePayload = tuple[AISSentence, int, dict[TimeSource, int], _Stamp | None, str]
 NO_TIME_SOURCE = "none"
 
 
@@ -163,17 +177,19 @@ class _Fragments:
 
     sentences: list[AISSentence]
     line_no: int
-    timestamp: _Stamp | None
+    available: dict[TimeSource, int]  # the first fragment's times; its $PGHP comes at the end
+    adjacent: Pghp | None  # the $PGHP right before the first fragment
     raw: list[str]
     broken: bool = False
+    later: _Stamp | None = None  # the time of the first later fragment that has one
 
-    def add(self, sentence: AISSentence, timestamp: _Stamp | None, raw: str) -> None:
+    def add(self, sentence: AISSentence, stamp: _Stamp | None, raw: str) -> None:
         if sentence.frag_num != len(self.sentences) + 1:
             self.broken = True
         self.sentences.append(sentence)
         self.raw.append(raw)
-        if self.timestamp is None:
-            self.timestamp = timestamp
+        if self.later is None:
+            self.later = stamp
 
 
 _STATIC_ONLY = (
@@ -203,10 +219,16 @@ class _NmeaReader:
         self.keep_timeless = keep_timeless
         self.counts = counts if counts is not None else NmeaCounts()
         self.time_sources = tuple(TimeSource(s) for s in time_sources)
-        self.pending: dict[TimeSource, int] = {}
+        self.pending: dict[TimeSource, int] = {}  # a tag block alone on the line before
         self.open_groups: dict[tuple[str, str, int | None, int], _Fragments] = {}
         self.positions = NmeaColumns()
         self.statics = NmeaColumns()
+        self.matcher = PghpMatcher()
+        self.pairings: Counter[Pairing] = Counter()
+        # Bound once: called for every message.
+        self._release_message = self._message_released
+        self._release_reject = self._reject_released
+        self._static_only_appends = tuple(getattr(self.positions, n).append for n in _STATIC_ONLY)
 
     # -- lines ------------------------------------------------------------------------------
 
@@ -214,6 +236,9 @@ class _NmeaReader:
         text = line.strip()
         if not text:
             return
+        matcher = self.matcher
+        if matcher.dormant or matcher.undecided or matcher.queue:
+            matcher.advance(line_no)
         line_tag_ms: int | None = None
         if text[0] == "\\":
             end = text.find("\\", 1)
@@ -226,28 +251,37 @@ class _NmeaReader:
                 if line_tag_ms is not None:
                     self.pending[TimeSource.TAG_BLOCK] = line_tag_ms
                 return
-        is_ais = text[3:6].upper() in ("VDM", "VDO")
-        # Some receivers and converters start AIS sentences with '$'; pyais reads them too.
-        if text[0] == "$" and not is_ais:
-            self._other_sentence(text)
-            return
         if text[0] not in "!$":
             self._unparseable(line_no, "not an NMEA sentence", line.strip())
             return
-        if not is_ais:
-            self.pending.clear()
+        # Some receivers and converters start AIS sentences with '$'; pyais reads them too.
+        if text[3:6].upper() not in ("VDM", "VDO"):
+            self._other_sentence(line_no, text)
             return
         sentence_text, arrival_ms = _split_time_suffix(text)
-        available = dict(self.pending)
-        self.pending.clear()
+        available = self.pending
+        self.pending = {}
         if line_tag_ms is not None:
             available[TimeSource.TAG_BLOCK] = line_tag_ms
         if arrival_ms is not None:
             available[TimeSource.ARRIVAL] = arrival_ms
+        self._ais_sentence(line_no, sentence_text, available)
+
+    def _other_sentence(self, line_no: int, text: str) -> None:
+        self.pending.clear()
+        if text[:6].upper() == "$PGHP,":
+            self.matcher.skip_adjacent()
+            parsed = parse_pghp(text)
+            if parsed is not None:
+                self.matcher.pghp(line_no, *parsed)
+            return
+        # Other sentences ($PSTT, ...) are no rows, but take their $PGHP like any sentence.
+        self.matcher.add(line_no, self.matcher.take_adjacent(), _written_checksum(text), None)
+
+    def _stamp(self, available: dict[TimeSource, int]) -> _Stamp | None:
+        """The time of the first source in use that ``available`` has (and its finer twin)."""
         stamp = next(((available[s], s) for s in self.time_sources if s in available), None)
-        self._ais_sentence(
-            line_no, sentence_text, _finer_observation(stamp, available, self.time_sources)
-        )
+        return _finer_observation(stamp, available, self.time_sources)
 
     def _tag_block_time(self, tag_block: str) -> int | None:
         if "c:" not in tag_block:
@@ -261,49 +295,88 @@ class _NmeaReader:
             return None
         return _unix_ms(block.receiver_timestamp)
 
-    def _other_sentence(self, text: str) -> None:
-        self.pending.clear()
-        if text[:6].upper() == "$PGHP,":
-            pghp_ms = pghp_time_ms(text)
-            if pghp_ms is not None:
-                self.pending[TimeSource.PGHP] = pghp_ms
-
-    def _ais_sentence(self, line_no: int, text: str, timestamp: _Stamp | None) -> None:
+    def _ais_sentence(self, line_no: int, text: str, available: dict[TimeSource, int]) -> None:
         try:
             sentence = NMEASentenceFactory.produce(text.encode("ascii"))
         except (UnicodeEncodeError, AISBaseException, ValueError) as err:
-            self._unparseable(line_no, f"malformed sentence ({err})", text)
+            self._bad_sentence(line_no, f"malformed sentence ({err})", text)
             return
         if not isinstance(sentence, AISSentence):
-            self._unparseable(line_no, "malformed sentence", text)
+            self._bad_sentence(line_no, "malformed sentence", text)
             return
         if not sentence.is_valid:
-            self._unparseable(line_no, "checksum does not match", text)
+            self._bad_sentence(line_no, "checksum does not match", text)
             return
         if sentence.frag_cnt == 1:
-            self._message(sentence, line_no, timestamp, text)
+            self._queue_message(
+                sentence,
+                line_no,
+                available,
+                self.matcher.take_adjacent(),
+                None,
+                text,
+                sentence.checksum,
+            )
             return
         key = (text[1:6].upper(), sentence.channel, sentence.seq_id, sentence.frag_cnt)
         group = self.open_groups.get(key)
         if sentence.frag_num == 1 or group is None:
             if group is not None:
                 self._incomplete(group)
-            group = _Fragments([sentence], line_no, timestamp, [text], sentence.frag_num != 1)
+            adjacent = self.matcher.take_adjacent()
+            group = _Fragments(
+                [sentence], line_no, available, adjacent, [text], sentence.frag_num != 1
+            )
             self.open_groups[key] = group
         else:
-            group.add(sentence, timestamp, text)
+            self.matcher.skip_adjacent()
+            group.add(sentence, self._stamp(available), text)
         if sentence.frag_num == sentence.frag_cnt:
             del self.open_groups[key]
             if group.broken:
                 self._incomplete(group)
             else:
-                whole = AISSentence.assemble_from_iterable(group.sentences)
-                self._message(whole, group.line_no, group.timestamp, " ".join(group.raw))
+                self._queue_message(
+                    AISSentence.assemble_from_iterable(group.sentences),
+                    group.line_no,
+                    group.available,
+                    group.adjacent,
+                    group.later,
+                    " ".join(group.raw),
+                    reduce(xor, (s.checksum for s in group.sentences)),
+                )
+
+    def _queue_message(
+        self,
+        sentence: AISSentence,
+        line_no: int,
+        available: dict[TimeSource, int],
+        adjacent: Pghp | None,
+        later: _Stamp | None,
+        raw: str,
+        checksum: int,
+    ) -> None:
+        payload = (sentence, line_no, available, later, raw)
+        self.matcher.add(line_no, adjacent, checksum, self._release_message, payload)
+
+    def _message_released(self, payload: object, pghp: Pghp | None, how: Pairing) -> None:
+        """Decode a message once its $PGHP is settled: with the times of its first sentence
+        (and the $PGHP's), else the first time of a later fragment."""
+        sentence, line_no, available, later, raw = cast(_MessagePayload, payload)
+        self.pairings[how] += 1
+        if pghp is not None:
+            available[TimeSource.PGHP] = pghp.time_ms
+        self._message(sentence, line_no, self._stamp(available) or later, raw)
 
     def finish(self) -> None:
         for group in self.open_groups.values():
             self._incomplete(group)
         self.open_groups.clear()
+        self.matcher.finish()
+        if self.matcher.pghp_lines:
+            self.pairings[Pairing.PGHP_UNMATCHED] = self.matcher.pghp_unmatched
+            for pairing in Pairing:
+                self.ledger.pghp_pairing[pairing.value] += self.pairings[pairing]
 
     # -- messages ---------------------------------------------------------------------------
 
@@ -318,7 +391,7 @@ class _NmeaReader:
                     RejectReason.UNPARSEABLE,
                     line_no,
                     f"no time from the time sources in use ({used}): no valid $PGHP line "
-                    "before it, no tag block c: with a valid checksum, no trailing unix time",
+                    "for it, no tag block c: with a valid checksum, no trailing unix time",
                     raw,
                 )
                 return
@@ -403,8 +476,8 @@ class _NmeaReader:
         if msg_type == 19:
             _append_static_fields(columns, decoded)
         else:
-            for name in _STATIC_ONLY:
-                getattr(columns, name).append(None)
+            for append in self._static_only_appends:
+                append(None)
 
     # -- rejects ----------------------------------------------------------------------------
 
@@ -415,18 +488,33 @@ class _NmeaReader:
     def _reject_message(self, reason: RejectReason, line_no: int, why: str, raw: str) -> None:
         self.ledger.reject(reason, example=self._example(line_no, why, raw))
 
-    def _unparseable(self, line_no: int, why: str, raw: str) -> None:
+    def _queue_reject(
+        self, reason: RejectReason, line_no: int, why: str, raw: str, adjacent: Pghp | None = None
+    ) -> None:
+        """Count a reject in its turn, after the messages before it (file order)."""
+        self.matcher.add(line_no, adjacent, None, self._release_reject, (reason, line_no, why, raw))
+
+    def _reject_released(self, payload: object, _pghp: Pghp | None, _how: Pairing) -> None:
+        reason, line_no, why, raw = cast(tuple[RejectReason, int, str, str], payload)
         self.ledger.read()
-        self._reject_message(RejectReason.UNPARSEABLE, line_no, why, raw)
+        self._reject_message(reason, line_no, why, raw)
+
+    def _unparseable(self, line_no: int, why: str, raw: str) -> None:
+        self._queue_reject(RejectReason.UNPARSEABLE, line_no, why, raw)
+
+    def _bad_sentence(self, line_no: int, why: str, raw: str) -> None:
+        """An AIS sentence line that cannot be read: no $PGHP can time it."""
+        self.matcher.skip_adjacent()
+        self._unparseable(line_no, why, raw)
 
     def _incomplete(self, group: _Fragments) -> None:
-        self.ledger.read()
         have = ",".join(str(s.frag_num) for s in group.sentences)
-        self._reject_message(
+        self._queue_reject(
             RejectReason.INCOMPLETE_MULTIPART,
             group.line_no,
             f"fragments {have} of {group.sentences[0].frag_cnt}",
             " ".join(group.raw),
+            group.adjacent,
         )
 
 
@@ -497,22 +585,28 @@ def _nmea_checksum_ok(text: str) -> bool:
     star = text.rfind("*")
     if star < 1 or len(text) < star + 3:
         return False
-    computed = 0
-    for char in text[1:star]:
-        computed ^= ord(char)
     try:
-        return computed == int(text[star + 1 : star + 3], 16)
-    except ValueError:
+        computed = reduce(xor, text[1:star].encode("ascii"), 0)
+    except UnicodeEncodeError:
         return False
+    return computed == _hex_byte(text[star + 1 : star + 3])
 
 
 def pghp_time_ms(text: str) -> int | None:
-    """The time of a Gatehouse ``$PGHP`` line in milliseconds, or None.
+    """The time of a Gatehouse ``$PGHP`` line in milliseconds, or None (``parse_pghp``)."""
+    parsed = parse_pghp(text)
+    return None if parsed is None else parsed[0]
+
+
+def parse_pghp(text: str) -> tuple[int, int | None] | None:
+    """The time of a Gatehouse ``$PGHP`` line in milliseconds and the checksum of the
+    sentence it times (None if it gives none), or None if it gives no time.
 
     Fields: ``$PGHP,<type>,<year>,<month>,<day>,<hour>,<minute>,<second>,<millisecond>,...``.
     What follows the milliseconds varies by feed (DMA: country, region, site MMSI, online
-    flag; satellite feeds: the origin, e.g. ``1AIS_S``) and is not read. The checksum must
-    match and the date must exist.
+    flag; satellite feeds: the origin, e.g. ``1AIS_S``) and is not read, up to the 14th field:
+    the sentence's checksum (nmea_pghp.py). The line's own checksum must match and the date
+    must exist.
     """
     if not _nmea_checksum_ok(text):
         return None
@@ -520,13 +614,41 @@ def pghp_time_ms(text: str) -> int | None:
     if len(fields) < 9:
         return None
     try:
-        year, month, day, hour, minute, second, millisecond = (int(f) for f in fields[2:9])
-        moment = datetime(year, month, day, hour, minute, second, tzinfo=UTC)
+        year, month, day, hour, minute, second, millisecond = map(int, fields[2:9])
     except ValueError:
         return None
-    if not 0 <= millisecond < 1000:
+    day_ms = _day_start_ms(year, month, day)
+    if day_ms is None or not (
+        0 <= hour < 24 and 0 <= minute < 60 and 0 <= second < 60 and 0 <= millisecond < 1000
+    ):
         return None
-    return round(moment.timestamp()) * 1000 + millisecond
+    checksum = _hex_byte(fields[13]) if len(fields) > 13 else None
+    return day_ms + ((hour * 60 + minute) * 60 + second) * 1000 + millisecond, checksum
+
+
+@lru_cache(maxsize=256)
+def _day_start_ms(year: int, month: int, day: int) -> int | None:
+    """Midnight UTC of a date that exists, in milliseconds (a log's lines share a few)."""
+    try:
+        return round(datetime(year, month, day, tzinfo=UTC).timestamp()) * 1000
+    except (ValueError, OverflowError):
+        return None
+
+
+def _hex_byte(digits: str) -> int | None:
+    """Two hex digits (an NMEA checksum) as an int, else None."""
+    if len(digits) != 2 or not digits.isalnum():  # int() would take "+1" or " 1"
+        return None
+    try:
+        return int(digits, 16)
+    except ValueError:
+        return None
+
+
+def _written_checksum(text: str) -> int | None:
+    """The checksum a sentence line carries after its ``*`` (not checked)."""
+    star = text.rfind("*")
+    return None if star < 0 else _hex_byte(text[star + 1 : star + 3])
 
 
 def read_nmea(

@@ -16,6 +16,7 @@ import gzip
 import hashlib
 import io
 import lzma
+import stat
 import zipfile
 import zlib
 from collections.abc import Iterator
@@ -70,17 +71,23 @@ class Source:
 def inspect_source(path: Path) -> Source:
     """Check that ``path`` is a readable, non-empty file and find its compression."""
     path = Path(path)
-    if not path.exists():
-        raise InputFileError(f"{path}: no such file; check the path")
-    if path.is_dir():
+    try:
+        status = path.stat()
+    except FileNotFoundError:
+        raise InputFileError(f"{path}: no such file; check the path") from None
+    except OSError as exc:  # a symbolic link that loops, a name too long, a file on the way
+        raise InputFileError(
+            f"{path}: cannot open it ({exc.strerror}); check the path and its symbolic links"
+        ) from None
+    if stat.S_ISDIR(status.st_mode):
         raise InputFileError(f"{path}: not a file; give AIS files, not a directory")
-    if not path.is_file():
+    if not stat.S_ISREG(status.st_mode):
         # Each input is read twice (its sha256, then its rows), which a stream cannot give.
         raise InputFileError(
             f"{path}: a pipe or a device, not a file; give the AIS file itself (compressed or "
             "not: colregs9 decompresses it)"
         )
-    size = path.stat().st_size
+    size = status.st_size
     if size == 0:
         raise InputFileError(f"{path}: the file is empty; give a file with AIS data")
     with path.open("rb") as handle:

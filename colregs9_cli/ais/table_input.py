@@ -282,6 +282,12 @@ def read_parquet_file(read: FileRead) -> FileResult:
     except (pa.ArrowException, OSError) as exc:
         raise InputFileError(f"{source.name}: not a readable Parquet file ({exc})") from None
     names = parquet.schema_arrow.names
+    twice = [c for c in CANONICAL_COLUMNS if names.count(c) > 1]
+    if twice:  # which of them holds the data cannot be told; other columns are not read
+        raise InputFileError(
+            f"{source.name}: the Parquet file has the column {twice[0]!r} "
+            f"{names.count(twice[0])} times; write it again with each canonical column once"
+        )
     # A, B, C, D may be absent: files written before the canonical schema had them.
     required = [c for c in CANONICAL_COLUMNS if c not in ANTENNA_OFFSETS]
     missing = [c for c in required if c not in names]

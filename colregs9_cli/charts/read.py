@@ -8,7 +8,9 @@ Sources
   options, so no global ``OGR_S57_OPTIONS`` is needed.
 - GeoJSON (``.geojson``, ``.json``) and GeoPackage (``.gpkg``) files with the S-57 attribute
   names: the object class in a column ``OBJL`` (the acronym such as ``"DEPARE"`` or its numeric
-  S-57 code such as 42), ``DRVAL1`` and optionally ``DRVAL2`` and ``VALSOU``.
+  S-57 code such as 42), ``DRVAL1`` and optionally ``DRVAL2`` and ``VALSOU``. Features of the
+  routeing classes (``FAIRWY``, ``TSSLPT`` …, ``s57_classes.CHANNEL_CLASSES``) are not part of
+  the water; ``channels`` reads them from the same files.
 
 Each file is read on its own into ``_Features``: its geometries in WGS84 longitude/latitude
 with their object class and depths, its coverage and its level of detail, or a ``ChartError``
@@ -33,7 +35,13 @@ from pyproj.exceptions import CRSError
 from ..errors import ChartError
 from .cells import _check_depth_unit, _dsid_fields, _whole_number, cell_purpose
 from .gdal_layers import S57_OPEN_OPTIONS, _list_layers, _read_layer
-from .s57_classes import _ACRONYM_BY_CODE, _BLOCKING_CLASSES, _OBJECT_CLASSES, _POLYGONAL
+from .s57_classes import (
+    _ACRONYM_BY_CODE,
+    _BLOCKING_CLASSES,
+    _OBJECT_CLASSES,
+    _POLYGONAL,
+    CHANNEL_CLASSES,
+)
 
 S57_SUFFIXES = (".000",)
 VECTOR_SUFFIXES = (".geojson", ".json", ".gpkg")
@@ -194,7 +202,10 @@ def _read_vector(path: Path) -> _Features:
 
 
 def _is_class_name(layer: str) -> bool:
-    return layer.upper() in _OBJECT_CLASSES or layer.upper() == "M_COVR"
+    """A layer named after an S-57 object class the charts are read for (its features take
+    that class); routeing layers (FAIRWY …) are left to ``channels``."""
+    name = layer.upper()
+    return name in _OBJECT_CLASSES or name in CHANNEL_CLASSES or name == "M_COVR"
 
 
 def _dsid_detail(columns: Mapping[str, Any], detail: dict[str, float]) -> None:

@@ -23,15 +23,18 @@ holds decides:
    Before ``in-company``: two towboats drifting side by side are not sailing together.
 4. ``in-company``: for ``company_min_s`` both vessels make way on courses over ground within
    ``company_course_deg`` of each other, and the relative position, in the frame of their
-   mean course, stays within a box of ``company_drift_m`` (or ``company_drift_frac`` of the
-   range, if larger): a tow, a convoy, an escort, tugs in company. The box is what tells
+   mean course (a formation turning in succession) or over ground (one turning together),
+   stays within a box of ``company_drift_m`` (or ``company_drift_frac`` of the range, if
+   larger): a tow, a convoy, an escort, tugs in company. The box is what tells
    them from a slow overtaking, whose range also changes slowly but whose relative
    position runs along the formation.
 5. ``encounter``: none of the above.
 
 Every measure is symmetric in the two vessels (ranges, relative velocities, tests applied
 to both), so both seats get the same kind, and only the rows within ``interaction_window_s``
-of the trigger are read, so the kind does not depend on how long the series is. The series
+of the trigger are read (for ``alongside`` and ``service`` also up to the predicted closest
+approach and ``interaction_window_s`` past it), so the kind does not depend on how long the
+series is. The series
 should reach ``interaction_window_s`` before the trigger (``window_steps``): a ferry leaving
 her berth reports SOG under ``min_sog_kn`` until her candidate run starts, and her time at
 the berth is the evidence.
@@ -203,6 +206,12 @@ def window_steps(params: InteractionParams, step_s: float) -> int:
     return math.ceil(params.interaction_window_s / step_s - 1e-9)
 
 
+def approach_steps(approach_s: float, step_s: float) -> int:
+    """How many steps past the trigger's window the alongside and service tests read: up
+    to the predicted closest approach (TCPA at the trigger, at least 0)."""
+    return math.ceil(max(approach_s, 0.0) / step_s - 1e-9)
+
+
 @dataclass(frozen=True)
 class _Vessel:
     """One vessel's measures over the window."""
@@ -241,29 +250,37 @@ def classify_interaction(
     facts: tuple[VesselFacts, VesselFacts],
     params: InteractionParams,
     step_s: float,
+    approach_s: float = 0.0,
 ) -> Interaction:
     """The interaction of a triggered pair (see the module docstring for the tests).
 
     ``series``: the pair's steps as ``encounters.encounter_series`` gives them (``own_*`` is
     vessel a with ``facts[0]``, ``target_*`` vessel b with ``facts[1]``); ``trigger_row``
-    its row of the trigger; ``step_s`` the grid step. Only the rows within
-    ``interaction_window_s`` of the trigger, on consecutive steps, are read.
+    its row of the trigger; ``step_s`` the grid step; ``approach_s`` the TCPA at the
+    trigger. Only the rows on consecutive steps within ``interaction_window_s`` of the
+    trigger are read, and for ``alongside`` and ``service`` also those up to
+    ``interaction_window_s`` past the predicted closest approach (``approach_steps``): a
+    pilot boat triggers minutes before she reaches the ladder, and what she does there is
+    what she is.
     """
-    window = _window(series, trigger_row, facts, params, step_s)
-    if window is None:
+    near = _window(series, trigger_row, facts, params, step_s, 0.0)
+    if near is None:
         return Interaction(
             InteractionKind.ENCOUNTER,
             "under two steps around the trigger: nothing to judge",
             -1,
             -1,
         )
-    first, last = int(window.steps[0]), int(window.steps[-1])
-    for test in (_alongside, _service, _not_making_way, _in_company):
+    wide = _window(series, trigger_row, facts, params, step_s, approach_s)
+    assert wide is not None  # it holds the near window
+    tests = ((_alongside, wide), (_service, wide), (_not_making_way, near), (_in_company, near))
+    for test, window in tests:
         found = test(window, params)
         if found is not None:
             kind, basis = found
-            return Interaction(kind, basis, first, last)
-    return Interaction(InteractionKind.ENCOUNTER, _encounter_basis(window), first, last)
+            return Interaction(kind, basis, int(window.steps[0]), int(window.steps[-1]))
+    basis = _encounter_basis(near)
+    return Interaction(InteractionKind.ENCOUNTER, basis, int(near.steps[0]), int(near.steps[-1]))
 
 
 # -- the window -----------------------------------------------------------------------------
@@ -275,9 +292,11 @@ def _window(
     facts: tuple[VesselFacts, VesselFacts],
     params: InteractionParams,
     step_s: float,
+    approach_s: float,
 ) -> _Window | None:
-    """The rows within the window around the trigger, on consecutive steps with both
-    positions known, measured; None when that is under two rows."""
+    """The rows within the window around the trigger, reaching ``approach_s`` further after
+    it, on consecutive steps with both positions known, measured; None when that is under
+    two rows."""
     if not 0 <= trigger_row < len(series):
         return None
     steps = series["step"].to_numpy(dtype=np.int64)
@@ -288,7 +307,9 @@ def _window(
         return None
     trigger_step = int(steps[trigger_row])
     # the run of usable rows on consecutive steps that holds the trigger, within reach
-    near = np.flatnonzero(np.abs(steps - trigger_step) <= window_steps(params, step_s))
+    reach = window_steps(params, step_s)
+    after = reach + approach_steps(approach_s, step_s)
+    near = np.flatnonzero((steps >= trigger_step - reach) & (steps <= trigger_step + after))
     usable = known[near] & (steps[near] - trigger_step == near - trigger_row)
     at = int(np.searchsorted(near, trigger_row))
     breaks = np.flatnonzero(~usable)
@@ -454,15 +475,23 @@ def _in_company(window: _Window, params: InteractionParams) -> _Found:
     course_apart_deg = _angle_between_deg(a.velocity_mps, b.velocity_mps)
     if course_apart_deg.max() > params.company_course_deg:
         return None
-    along_m, across_m = _formation_offsets(window)
-    drift_m = math.hypot(float(np.ptp(along_m)), float(np.ptp(across_m)))
+    (along_m, across_m), (north_m, east_m) = _formation_offsets(window)
+    # A formation that turns in succession (a tow, a column) keeps its shape in the frame
+    # of its course; one that turns together (ships abreast, each turning on the spot)
+    # keeps it in the Earth's: either is in company.
+    drifts_m = {
+        "along the course": math.hypot(float(np.ptp(along_m)), float(np.ptp(across_m))),
+        "over ground": math.hypot(float(np.ptp(north_m)), float(np.ptp(east_m))),
+    }
+    frame, drift_m = min(drifts_m.items(), key=lambda item: item[1])
     median_range_m = float(np.median(window.range_m))
     allowed_m = max(params.company_drift_m, params.company_drift_frac * median_range_m)
     if drift_m > allowed_m:
         return None
     return InteractionKind.IN_COMPANY, (
-        f"range {_spread(window.range_m, 'm')}, relative position within {drift_m:.0f} m "
-        f"(<= {allowed_m:.0f} m), courses within {course_apart_deg.max():.0f}° at "
+        f"range {_spread(window.range_m, 'm')}, relative position {frame} within "
+        f"{drift_m:.0f} m (<= {allowed_m:.0f} m), courses within "
+        f"{course_apart_deg.max():.0f}° at "
         f"{_spread(a.speed_kn, 'kn', 1)} and {_spread(b.speed_kn, 'kn', 1)} for "
         f"{window.span_s(0, len(window.steps) - 1):.0f} s"
     )
@@ -475,9 +504,13 @@ def _angle_between_deg(u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArra
     return np.degrees(np.arctan2(cross, dot))
 
 
-def _formation_offsets(window: _Window) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """b's offset from a along and across the pair's mean course over ground, in the
-    tangent plane at their midpoint (a turn of the formation leaves it unchanged)."""
+Offsets = tuple[NDArray[np.float64], NDArray[np.float64]]
+
+
+def _formation_offsets(window: _Window) -> tuple[Offsets, Offsets]:
+    """b's offset from a along and across the pair's mean course over ground (a turn in
+    succession leaves it unchanged), and north and east (a turn together leaves it
+    unchanged), in the tangent plane at their midpoint."""
     a, b = window.vessels
     middle = (a.position_m + b.position_m) / 2.0
     length = np.linalg.norm(middle, axis=-1, keepdims=True)
@@ -491,7 +524,7 @@ def _formation_offsets(window: _Window) -> tuple[NDArray[np.float64], NDArray[np
     r_north, r_east = in_tangent_plane(b.position_m - a.position_m, lat_deg, lon_deg)
     along = r_north * np.cos(theta) + r_east * np.sin(theta)
     across = -r_north * np.sin(theta) + r_east * np.cos(theta)
-    return along, across
+    return (along, across), (r_north, r_east)
 
 
 def _encounter_basis(window: _Window) -> str:

@@ -35,27 +35,28 @@ from typing import Any, TypeVar
 import numpy as np
 import pandas as pd
 
+from ..charts.channel_facts import ChannelRelation
+from ..charts.channels import Channels
 from ..charts.water import Chart
 from ..geo import sail
-from .ais_claims import NavStatusBelief, NavStatusParams, nav_status_belief
+from .ais_claims import NavStatus, NavStatusBelief, NavStatusParams, nav_status_belief
 from .audit import (
-    INSUFFICIENT_CONDUCT,
     Conduct,
     ConductParams,
     Fact,
     action_as_rule_asks,
     all_of,
-    conduct,
     stand_on_turned_to_port_for_vessel_on_port,
 )
+from .channel_audit import NOT_CHARTED, ChannelAuditParams, VesselInChannel, vessel_in_channel
 from .colregs import ColregsEvaluation, ColregsParams, Kinematics, Role, evaluate_colregs
 from .encounters import Encounter, EncounterParams, encounter_series
-from .hull import HullOffsets, least_hull_distance_geodetic_m, offsets_from_ais
 from .interactions import (
     Interaction,
     InteractionKind,
     InteractionParams,
     VesselFacts,
+    approach_steps,
     classify_interaction,
     window_steps,
 )
@@ -68,16 +69,24 @@ from .manoeuvrability import (
     assess_manoeuvrability,
     unplaced_assessment,
 )
-from .passing import Passing, PassingParams, horizon_steps, minimum_evidence, passing
-from .rule9 import Finding, PairVerdict, Rule9Assessment, Rule9Params, decide_pair
+from .pair_audit import PREFIXES, PairAudit, audit_pair, hull_offsets
+from .passing import PassingParams, horizon_steps, passing
+from .rule9 import (
+    RULE_9B_LENGTH_M,
+    ChannelStanding,
+    Finding,
+    PairVerdict,
+    Rule9Assessment,
+    Rule9Clause,
+    Rule9Params,
+    decide_pair,
+    rule9_clause,
+)
 from .rule9 import nav_status_finding as _finding
-from .tracks import ANTENNA_OFFSET_COLUMNS, Tracks
+from .tracks import Tracks
 from .vessel_defaults import DimensionDefaults, VesselDimensions, vessel_dimensions
 
 T = TypeVar("T")
-
-# The series' column prefixes of vessels a and b.
-PREFIXES = ("own_", "target_")
 
 
 @dataclass(frozen=True)
@@ -93,6 +102,7 @@ class PairParams:
     passing: PassingParams
     interactions: InteractionParams
     claims: NavStatusParams
+    channels: ChannelAuditParams
 
 
 @dataclass(frozen=True)
@@ -113,6 +123,7 @@ class VesselAtTrigger:
     estimated_restricted: Restriction
     conduct: Conduct
     action_before_cpa_s: float | None
+    ship_type: str | None = None
 
     @property
     def nav_status_used(self) -> int | None:
@@ -134,59 +145,6 @@ class PairSteps:
 
 
 @dataclass(frozen=True)
-class PairAudit:
-    """The pass and both vessels' conduct up to the closest approach (vessel order a, b)."""
-
-    covers_cpa: bool
-    min_separation_m: float | None
-    cpa_utc: pd.Timestamp | None
-    conducts: tuple[Conduct, Conduct]
-    before_cpa_s: tuple[float | None, float | None]
-    min_hull_separation_m: float | None = None
-    # Either hull's antenna placed by assumption, not by her AIS A, B, C, D (None: no hull
-    # distance).
-    hull_antenna_position_assumed: bool | None = None
-    # What the least separation rests on (passing.MinimumEvidence; None: no least separation).
-    min_separation_report_gap_s: float | None = None
-    min_separation_at_fixes_m: float | None = None
-    min_separation_interpolated: bool | None = None
-
-
-def hull_offsets(dimensions: VesselDimensions, static: dict[str, Any]) -> HullOffsets:
-    """A vessel's hull around her antenna: from her AIS A, B, C, D where her static row
-    (``_static``: the four from one report, ``tracks.latest_statics``) has them, else from
-    her reported length and breadth with the antenna amidships on the centre line, marked
-    ``defaulted`` (``hull.offsets_from_ais``); unknown when neither gives both the length and
-    the breadth (a table default is no hull)."""
-    length_m = None if "length_m" in dimensions.defaulted else dimensions.length_m
-    breadth_m = None if "breadth_m" in dimensions.defaulted else dimensions.breadth_m
-    a, b, c, d = (static.get(name) for name in ANTENNA_OFFSET_COLUMNS)
-    return offsets_from_ais(a, b, c, d, length_m, breadth_m)
-
-
-def least_hull_separation_m(
-    window: pd.DataFrame, offsets: tuple[HullOffsets, HullOffsets]
-) -> float | None:
-    """The least distance between the two hull outlines (``hull_offsets``) over ``window``
-    (rows of the pair's series, headings true: COG where the heading was not reported);
-    None where a hull is unknown."""
-    if not all(o.known for o in offsets) or window.empty:
-        return None
-    a, b = PREFIXES
-    distance = least_hull_distance_geodetic_m(
-        window[f"{a}lat_deg"],
-        window[f"{a}lon_deg"],
-        window[f"{a}heading_deg"],
-        offsets[0],
-        window[f"{b}lat_deg"],
-        window[f"{b}lon_deg"],
-        window[f"{b}heading_deg"],
-        offsets[1],
-    )
-    return float(np.nanmin(distance)) if np.isfinite(distance).any() else None
-
-
-@dataclass(frozen=True)
 class PairEvaluation:
     """One triggered pair, evaluated once, in vessel order (a, b) with a the lower MMSI.
 
@@ -203,6 +161,32 @@ class PairEvaluation:
     restricted_nav_statuses: frozenset[int]
     interaction: Interaction
     swing_model: SwingModel
+    # Each vessel and the charted channels (channel_audit.py), vessel order.
+    in_channel: tuple[VesselInChannel, VesselInChannel] = (NOT_CHARTED, NOT_CHARTED)
+
+    @property
+    def rule9_clause(self) -> Rule9Clause | None:
+        """Where rule 9 decided: the clause under which the other vessel keeps out of the way
+        of the one it made stand on (``rule9.rule9_clause``); None where it did not."""
+        verdict = self.verdict
+        if not verdict.rule9_applied:
+            return None
+        restricted = verdict.role_final.index(Role.STAND_ON)
+        return rule9_clause(self._standing(restricted), self._standing(1 - restricted))
+
+    def _standing(self, index: int) -> ChannelStanding:
+        vessel, place = self.vessels[index], self.in_channel[index]
+        status = vessel.nav_status_used
+        length_known = "length_m" not in vessel.dimensions.defaulted
+        relations = (place.at_trigger.relation, place.at_least_separation.relation)
+        return ChannelStanding(
+            along_channel=place.at_trigger.relation is ChannelRelation.ALONG,
+            crossing_channel=ChannelRelation.CROSSING in relations,
+            small_or_sailing=(length_known and vessel.dimensions.length_m < RULE_9B_LENGTH_M)
+            or vessel.ship_type == "Sailing"
+            or status == NavStatus.UNDER_WAY_SAILING,
+            fishing=vessel.ship_type == "Fishing" or status == NavStatus.ENGAGED_IN_FISHING,
+        )
 
     @property
     def is_encounter(self) -> bool:
@@ -574,93 +558,15 @@ def rests_on_defaults(
     return False
 
 
-def _audit(
-    window: pd.DataFrame,
-    seen: Passing,
-    hulls: tuple[HullOffsets, HullOffsets],
-    lengths_m: tuple[float, float],
-    params: ConductParams,
-    step_s: float,
-) -> PairAudit:
-    if seen.cpa_row is None:
-        return PairAudit(
-            False, None, None, (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT), (None, None)
-        )
-    audit = _audit_conduct(window, seen, seen.cpa_row, hulls, params, step_s)
-
-    def both(name: str) -> np.ndarray:
-        return window[[f"{prefix}{name}" for prefix in PREFIXES]].to_numpy(dtype=float)
-
-    evidence = minimum_evidence(
-        window["range_m"].to_numpy(dtype=float),
-        both("report_gap_s"),
-        both("nearest_report_s"),
-        both("speed_mps"),
-        lengths_m,
-        seen,
-        step_s,
-    )
-    if evidence is None:
-        return audit
-    return dataclasses.replace(
-        audit,
-        min_separation_report_gap_s=evidence.report_gap_s,
-        min_separation_at_fixes_m=evidence.at_fixes_m,
-        min_separation_interpolated=evidence.interpolated,
-    )
-
-
-def _audit_conduct(
-    window: pd.DataFrame,
-    seen: Passing,
-    cpa_row: int,
-    hulls: tuple[HullOffsets, HullOffsets],
-    params: ConductParams,
-    step_s: float,
-) -> PairAudit:
-    cpa_utc = window["timestamp"].iloc[cpa_row]
-    hull_m = least_hull_separation_m(window.iloc[: seen.end_row + 1], hulls)
-    assumed = None if hull_m is None else any(h.defaulted for h in hulls)
-    if not seen.covers_cpa:
-        # The least range so far is observed, but the closest approach may lie past the data:
-        # what the vessels did before it cannot be judged.
-        return PairAudit(
-            False,
-            seen.min_separation_m,
-            cpa_utc,
-            (INSUFFICIENT_CONDUCT, INSUFFICIENT_CONDUCT),
-            (None, None),
-            hull_m,
-            assumed,
-        )
-    until = window.iloc[: cpa_row + 1]
-    conducts = tuple(
-        conduct(
-            until[f"{prefix}course_deg"].to_numpy(dtype=float),
-            until[f"{prefix}sog_kn"].to_numpy(dtype=float),
-            params,
-        )
-        for prefix in PREFIXES
-    )
-    before = tuple(
-        None if c.action_row is None else (cpa_row - c.action_row) * step_s for c in conducts
-    )
-    return PairAudit(
-        covers_cpa=True,
-        min_separation_m=seen.min_separation_m,
-        cpa_utc=cpa_utc,
-        conducts=(conducts[0], conducts[1]),
-        before_cpa_s=(before[0], before[1]),
-        min_hull_separation_m=hull_m,
-        hull_antenna_position_assumed=assumed,
-    )
-
-
 def evaluate_pair(
-    tracks: Tracks, encounter: Encounter, chart: Chart | None, params: PairParams
+    tracks: Tracks,
+    encounter: Encounter,
+    chart: Chart | None,
+    params: PairParams,
+    channels: Channels | None = None,
 ) -> PairEvaluation:
     """One triggered pair, evaluated once (see the module docstring). ``encounter`` may be
-    either seat's; ``chart`` is in ``tracks.frame``."""
+    either seat's; ``chart`` and its ``channels`` are in ``tracks.frame``."""
     if encounter.trigger_step is None or encounter.tcpa_s_at_trigger is None:
         raise ValueError(f"encounter {encounter.encounter_id} never triggered")
     a, b = sorted((encounter.own_mmsi, encounter.target_mmsi))
@@ -691,7 +597,19 @@ def evaluate_pair(
         hull_offsets(dimensions[1], _static(tracks.vessels, b)),
     )
     lengths_m = (dimensions[0].length_m, dimensions[1].length_m)
-    audit = _audit(window, seen, hulls, lengths_m, params.conduct, step_s)
+    audit = audit_pair(window, seen, hulls, lengths_m, params.conduct, step_s)
+    in_channel = tuple(
+        vessel_in_channel(
+            window.iloc[: seen.end_row + 1],
+            prefix,
+            channels,
+            seen.cpa_row,
+            seen.covers_cpa,
+            step_s,
+            params.channels,
+        )
+        for prefix in PREFIXES
+    )
     interaction = _interaction(tracks, oriented, encounter.trigger_step, params.interactions)
     steps = _pair_steps(series, dimensions, claims, chart, params, step_s)
     trigger = series.iloc[0]
@@ -708,6 +626,7 @@ def evaluate_pair(
         restricted_nav_statuses=params.rule9.restricted_nav_statuses,
         interaction=interaction,
         swing_model=params.manoeuvrability.swing_model,
+        in_channel=(in_channel[0], in_channel[1]),
     )
 
 
@@ -717,18 +636,21 @@ def _interaction(
     """What the two vessels were doing around the trigger (``interactions.py``), judged on a
     window from before the candidate run: a ferry leaving her berth is slow until then."""
     lead = window_steps(params, tracks.step_s)
+    approach_s = pair.tcpa_s_at_trigger or 0.0
     around = encounter_series(
         pair_tracks(tracks, (pair.own_mmsi, pair.target_mmsi)),
         pair,
         from_step=trigger_step - lead,
-        to_step=trigger_step + lead,
+        to_step=trigger_step + lead + approach_steps(approach_s, tracks.step_s),
     ).reset_index(drop=True)
     trigger_row = int(np.searchsorted(around["step"].to_numpy(), trigger_step))
     facts = tuple(
         VesselFacts.from_static(mmsi, _static(tracks.vessels, mmsi))
         for mmsi in (pair.own_mmsi, pair.target_mmsi)
     )
-    return classify_interaction(around, trigger_row, (facts[0], facts[1]), params, tracks.step_s)
+    return classify_interaction(
+        around, trigger_row, (facts[0], facts[1]), params, tracks.step_s, approach_s
+    )
 
 
 def _vessel_at_trigger(
@@ -766,4 +688,5 @@ def _vessel_at_trigger(
         estimated_restricted=steps.estimates[index][0],
         conduct=audit.conducts[index],
         action_before_cpa_s=audit.before_cpa_s[index],
+        ship_type=text_or_none(_static(tracks.vessels, mmsi).get("ship_type")),
     )

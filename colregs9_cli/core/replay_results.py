@@ -81,6 +81,11 @@ class ReplayResult:
     counts: ReplayCounts
     manifest: dict[str, Any]
     files: tuple[Path, ...]
+    # Every vessel's track over the run, a row per vertex: ``mmsi``, ``piece`` (0, 1, … at
+    # each track split), ``t_s`` (epoch seconds), ``lat_deg``, ``lon_deg``, ``reports``
+    # (decided reports from it up to the next vertex), ``name``, ``ship_type``, ``length_m``
+    # (``jobs/slabs.track_vertices``, thinned to one report in 10 s).
+    vessel_tracks: pd.DataFrame
     text: str = ""  # the summary printed to stdout (report.replay_report.format_summary)
 
     @property

@@ -17,11 +17,12 @@ from typing import Any, TypeVar
 import pandas as pd
 
 from .audit import Action, Fact, all_of, negated
+from .channel_audit import VesselInChannel
 from .colregs import Role, Situation, SituationBasis
 from .interactions import InteractionKind
 from .manoeuvrability import Restriction, SwingModel
 from .pair import PairEvaluation, Seat, VesselAtTrigger, reports_restricted
-from .rule9 import DecidingRule
+from .rule9 import DecidingRule, Rule9Clause
 
 
 @dataclass(frozen=True)
@@ -58,6 +59,7 @@ class PairSummary:
     automaton_path_a: str | None
     automaton_path_b: str | None
     rule9_applied: bool | None
+    rule9_clause: Rule9Clause | None
     deciding_rule: DecidingRule | None
     both_restricted: bool | None
     role_final_a: Role | None
@@ -83,6 +85,32 @@ class PairSummary:
     min_separation_report_gap_s: float | None
     min_separation_at_fixes_m: float | None
     min_separation_interpolated: bool | None
+    largest_report_gap_s_a: float | None
+    largest_report_gap_s_b: float | None
+    reports_sparse_a: bool | None
+    reports_sparse_b: bool | None
+    channel_a: str | None
+    channel_b: str | None
+    channel_relation_a: str | None
+    channel_relation_b: str | None
+    channel_offset_m_a: float | None
+    channel_offset_m_b: float | None
+    channel_at_min_separation_a: str | None
+    channel_at_min_separation_b: str | None
+    channel_relation_at_min_separation_a: str | None
+    channel_relation_at_min_separation_b: str | None
+    channel_offset_m_at_min_separation_a: float | None
+    channel_offset_m_at_min_separation_b: float | None
+    keeps_to_starboard_side_a: Fact | None
+    keeps_to_starboard_side_b: Fact | None
+    keeps_to_starboard_side_basis_a: str | None
+    keeps_to_starboard_side_basis_b: str | None
+    follows_lane_direction_a: Fact | None
+    follows_lane_direction_b: Fact | None
+    crosses_lane_at_right_angles_a: Fact | None
+    crosses_lane_at_right_angles_b: Fact | None
+    traffic_lane_basis_a: str | None
+    traffic_lane_basis_b: str | None
     give_way_vessel_acted: Fact | None
     give_way_action: str | None
     give_way_action_as_rule_asks: Fact | None
@@ -117,6 +145,7 @@ PAIR_VERDICT_COLUMNS: tuple[str, ...] = (
     "automaton_path_a",
     "automaton_path_b",
     "rule9_applied",
+    "rule9_clause",
     "deciding_rule",
     "both_restricted",
     "role_final_a",
@@ -131,6 +160,16 @@ PAIR_VERDICT_COLUMNS: tuple[str, ...] = (
     "stand_on_turned_to_port_for_vessel_on_port",
     "action_a",
     "action_b",
+    "keeps_to_starboard_side_a",
+    "keeps_to_starboard_side_b",
+    "keeps_to_starboard_side_basis_a",
+    "keeps_to_starboard_side_basis_b",
+    "follows_lane_direction_a",
+    "follows_lane_direction_b",
+    "crosses_lane_at_right_angles_a",
+    "crosses_lane_at_right_angles_b",
+    "traffic_lane_basis_a",
+    "traffic_lane_basis_b",
 )
 
 
@@ -172,6 +211,7 @@ class EncounterSummary:
     automaton_path: str | None
     target_seat_automaton_path: str | None
     rule9_applied: bool | None
+    rule9_clause: Rule9Clause | None
     deciding_rule: DecidingRule | None
     both_restricted: bool | None
     own_role_final: Role | None
@@ -198,6 +238,32 @@ class EncounterSummary:
     min_separation_report_gap_s: float | None
     min_separation_at_fixes_m: float | None
     min_separation_interpolated: bool | None
+    own_largest_report_gap_s: float | None
+    target_largest_report_gap_s: float | None
+    own_reports_sparse: bool | None
+    target_reports_sparse: bool | None
+    own_channel: str | None
+    target_channel: str | None
+    own_channel_relation: str | None
+    target_channel_relation: str | None
+    own_channel_offset_m: float | None
+    target_channel_offset_m: float | None
+    own_channel_at_min_separation: str | None
+    target_channel_at_min_separation: str | None
+    own_channel_relation_at_min_separation: str | None
+    target_channel_relation_at_min_separation: str | None
+    own_channel_offset_m_at_min_separation: float | None
+    target_channel_offset_m_at_min_separation: float | None
+    own_keeps_to_starboard_side: Fact | None
+    target_keeps_to_starboard_side: Fact | None
+    own_keeps_to_starboard_side_basis: str | None
+    target_keeps_to_starboard_side_basis: str | None
+    own_follows_lane_direction: Fact | None
+    target_follows_lane_direction: Fact | None
+    own_crosses_lane_at_right_angles: Fact | None
+    target_crosses_lane_at_right_angles: Fact | None
+    own_traffic_lane_basis: str | None
+    target_traffic_lane_basis: str | None
     give_way_vessel_acted: Fact | None
     give_way_action: str | None
     give_way_action_as_rule_asks: Fact | None
@@ -230,6 +296,7 @@ ENCOUNTER_VERDICT_COLUMNS: tuple[str, ...] = (
     "automaton_path",
     "target_seat_automaton_path",
     "rule9_applied",
+    "rule9_clause",
     "deciding_rule",
     "both_restricted",
     "own_role_final",
@@ -243,6 +310,16 @@ ENCOUNTER_VERDICT_COLUMNS: tuple[str, ...] = (
     "action_before_cpa_s",
     "stand_on_vessel_kept_course",
     "stand_on_turned_to_port_for_vessel_on_port",
+    "own_keeps_to_starboard_side",
+    "target_keeps_to_starboard_side",
+    "own_keeps_to_starboard_side_basis",
+    "target_keeps_to_starboard_side_basis",
+    "own_follows_lane_direction",
+    "target_follows_lane_direction",
+    "own_crosses_lane_at_right_angles",
+    "target_crosses_lane_at_right_angles",
+    "own_traffic_lane_basis",
+    "target_traffic_lane_basis",
 )
 # The series columns of the verdict, empty for the other interactions.
 SERIES_VERDICT_COLUMNS: tuple[str, ...] = (
@@ -273,6 +350,7 @@ SERIES_VESSEL_FIELDS: tuple[str, ...] = (
     "course_deg",
     "sog_kn",
     "nav_status",
+    "report_gap_s",
 )
 SERIES_COLUMNS: tuple[str, ...] = (
     "step",
@@ -342,6 +420,32 @@ def _seconds(value: float | None) -> str:
     return "" if value is None else f"{value:g}"
 
 
+def _channel_fields(vessel: VesselInChannel, name: str) -> dict[str, Any]:
+    """A vessel's channel columns, named by ``name`` (``"{}_a"``, ``"own_{}"``)."""
+    trigger, least = vessel.at_trigger, vessel.at_least_separation
+    starboard = vessel.keeps_to_starboard_side
+    return {
+        name.format("channel"): trigger.channel,
+        name.format("channel_relation"): None if trigger.channel is None else trigger.relation,
+        name.format("channel_offset_m"): trigger.offset_m,
+        name.format("channel_at_min_separation"): least.channel,
+        name.format("channel_relation_at_min_separation"): (
+            None if least.channel is None else least.relation
+        ),
+        name.format("channel_offset_m_at_min_separation"): least.offset_m,
+        name.format("keeps_to_starboard_side"): starboard.fact,
+        name.format("keeps_to_starboard_side_basis"): starboard.basis,
+        name.format("follows_lane_direction"): vessel.lane.follows_lane,
+        name.format("crosses_lane_at_right_angles"): vessel.lane.crosses_at_right_angles,
+        name.format("traffic_lane_basis"): vessel.lane.basis,
+    }
+
+
+def _largest_gap_s(pair: PairEvaluation, vessel: int) -> float | None:
+    gaps = pair.audit.report_gaps[vessel]
+    return None if gaps is None else gaps.largest_gap_s
+
+
 def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
     """The pairs.csv row of ``pair``; ``seats``: the own-ship MMSIs reported."""
     verdict = pair.verdict
@@ -381,6 +485,7 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         automaton_path_a=verdict.seat_a.path_text,
         automaton_path_b=verdict.seat_b.path_text,
         rule9_applied=verdict.rule9_applied,
+        rule9_clause=pair.rule9_clause,
         deciding_rule=verdict.deciding_rule,
         both_restricted=verdict.both_restricted,
         role_final_a=verdict.role_final[0],
@@ -406,6 +511,12 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         min_separation_report_gap_s=pair.audit.min_separation_report_gap_s,
         min_separation_at_fixes_m=pair.audit.min_separation_at_fixes_m,
         min_separation_interpolated=pair.audit.min_separation_interpolated,
+        largest_report_gap_s_a=_largest_gap_s(pair, 0),
+        largest_report_gap_s_b=_largest_gap_s(pair, 1),
+        reports_sparse_a=pair.audit.reports_sparse(0),
+        reports_sparse_b=pair.audit.reports_sparse(1),
+        **_channel_fields(pair.in_channel[0], "{}_a"),
+        **_channel_fields(pair.in_channel[1], "{}_b"),
         give_way_vessel_acted=all_of(v.conduct.changed for v in give_way) if give_way else None,
         give_way_action=_joined([v.conduct.action.value for v in give_way]),
         give_way_action_as_rule_asks=pair.give_way_action_as_rule_asks,
@@ -473,6 +584,7 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         automaton_path=own_automaton.path_text,
         target_seat_automaton_path=target_automaton.path_text,
         rule9_applied=pair.rule9_applied,
+        rule9_clause=pair.rule9_clause,
         deciding_rule=pair.deciding_rule,
         both_restricted=pair.both_restricted,
         own_role_final=own_final,
@@ -499,6 +611,12 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         min_separation_report_gap_s=pair.min_separation_report_gap_s,
         min_separation_at_fixes_m=pair.min_separation_at_fixes_m,
         min_separation_interpolated=pair.min_separation_interpolated,
+        own_largest_report_gap_s=_largest_gap_s(seat.pair, seat.mine((0, 1))[0]),
+        target_largest_report_gap_s=_largest_gap_s(seat.pair, seat.mine((0, 1))[1]),
+        own_reports_sparse=seat.pair.audit.reports_sparse(seat.mine((0, 1))[0]),
+        target_reports_sparse=seat.pair.audit.reports_sparse(seat.mine((0, 1))[1]),
+        **_channel_fields(seat.mine(seat.pair.in_channel)[0], "own_{}"),
+        **_channel_fields(seat.mine(seat.pair.in_channel)[1], "target_{}"),
         give_way_vessel_acted=pair.give_way_vessel_acted,
         give_way_action=pair.give_way_action,
         give_way_action_as_rule_asks=pair.give_way_action_as_rule_asks,

@@ -57,6 +57,16 @@ from enum import Enum, StrEnum
 
 from .colregs import Role, Situation
 
+# What every verdict applies (DESIGN §7, jurisdiction): the international rules, not the
+# inland rules some waters have instead.
+RULES_APPLIED = (
+    "Rules applied: COLREGs 1972 as amended (rules 9, 13-15, 17 and 18, with the rule 9 "
+    "framework of Hansen et al., the paper this tool implements), the international rules "
+    "for the high seas and waters connected with them. Inland rules are not applied: where "
+    "they govern (the US Inland Rules, 33 CFR 83, which differ in rules 9(a)(ii), 14(d) and "
+    "15(b); the Kiel Canal; the Rhine; Japan's port rules) read the verdicts against them."
+)
+
 
 @dataclass(frozen=True)
 class Rule9Params:
@@ -341,3 +351,48 @@ def _claims_restriction(nav_status: int | None, restricted_nav_statuses: frozens
     return nav_status is not None and (
         int(nav_status) in restricted_nav_statuses or rule18_rank(nav_status) >= RULE18_RANK[4]
     )
+
+
+# Rule 9(b): "a vessel of less than 20 metres in length or a sailing vessel".
+RULE_9B_LENGTH_M = 20.0
+
+
+class Rule9Clause(StrEnum):
+    """Which clause of rule 9 bears out an inversion by rule 9 where the chart is known
+    (``rule9_clause``)."""
+
+    SMALL_OR_SAILING = "9(b)"  # under 20 m or sailing: shall not impede
+    FISHING = "9(c)"  # engaged in fishing: shall not impede
+    CROSSING = "9(d)"  # shall not cross a channel if that impedes
+    ESTIMATOR = "estimator"  # in no charted channel: the paper's estimator alone
+    NO_CLAUSE = "none"  # in a charted channel, but none of 9(b)-(d) binds the other vessel
+
+
+@dataclass(frozen=True)
+class ChannelStanding:
+    """What the clauses of rule 9 read about one vessel: whether she proceeds along a
+    charted channel, crosses one, is under 20 m or a sailing vessel, or is fishing."""
+
+    along_channel: bool
+    crossing_channel: bool
+    small_or_sailing: bool
+    fishing: bool
+
+
+def rule9_clause(restricted: ChannelStanding, other: ChannelStanding) -> Rule9Clause:
+    """The clause of rule 9 under which ``other`` keeps out of the way of ``restricted``, the
+    vessel rule 9 made stand on (the estimator found that she can safely navigate only
+    within the channel): 9(d) when the other crosses the channel, 9(b) when she is under
+    20 m or sailing, 9(c) when she is fishing; ``none`` when the restricted vessel proceeds
+    along a charted channel and none of these binds the other (two ships along it: rule 9
+    then asks each to keep to her starboard side, 9(a), and does not invert rules 13-15;
+    the paper's estimator did); ``estimator`` where no charted channel holds her."""
+    if not restricted.along_channel:
+        return Rule9Clause.ESTIMATOR
+    if other.crossing_channel:
+        return Rule9Clause.CROSSING
+    if other.small_or_sailing:
+        return Rule9Clause.SMALL_OR_SAILING
+    if other.fishing:
+        return Rule9Clause.FISHING
+    return Rule9Clause.NO_CLAUSE

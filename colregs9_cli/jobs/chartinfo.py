@@ -1,4 +1,5 @@
-"""``colregs9 chart``: a chart's summary and, for a draught, its navigable water and a plot."""
+"""``colregs9 chart``: a chart's summary with its charted channels and, for a draught, its
+navigable water and a plot or a GeoPackage."""
 
 from __future__ import annotations
 
@@ -14,6 +15,13 @@ import shapely
 from matplotlib.figure import Figure
 
 from ..charts.cells import CellInfo
+from ..charts.channels import (
+    AxisSource,
+    Channels,
+    NavigableWidth,
+    load_channels,
+    navigable_widths,
+)
 from ..charts.water import Chart, load_chart
 from ..errors import OutputError, ParameterError
 from ..outputs import atomic_path, check_out_file, save_figure
@@ -21,7 +29,14 @@ from ..progress import progress_bar, progress_enabled
 from ..report.chart_plot import draw_chart, geographic_axes
 
 DEFAULT_REPORTS_DIR = Path("reports")
-GEOPACKAGE_LAYERS = ("depth_areas", "coverage", "land", "navigable_water")
+GEOPACKAGE_LAYERS = (
+    "depth_areas",
+    "coverage",
+    "land",
+    "navigable_water",
+    "channels",
+    "channel_axes",
+)
 GEOPACKAGE_SUFFIX = ".gpkg"
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 PURPOSES = {1: "overview", 2: "general", 3: "coastal", 4: "approach", 5: "harbour", 6: "berthing"}
@@ -40,13 +55,22 @@ def _multipolygons(values: Any) -> np.ndarray:
     return out
 
 
-def write_chart_geopackage(path: Path, chart: Chart, draught_m: float, ukc_m: float) -> None:
+def write_chart_geopackage(
+    path: Path,
+    chart: Chart,
+    draught_m: float,
+    ukc_m: float,
+    channels: Channels | None = None,
+    navigable: Sequence[NavigableWidth | None] = (),
+) -> None:
     """The chart as a GeoPackage in WGS84 (EPSG:4326), written with GDAL through pyogrio,
     whole or not at all: ``depth_areas`` (with DRVAL1, DRVAL2, the S-57 class and the chart
     file it comes from), ``coverage`` (one feature per chart file: the part it decides, with
     its ``rank``, 1 the most detailed), ``land`` (no feature when the chart has none) and
     ``navigable_water`` (for the draught and UKC), so that an analyst can check in QGIS the
-    water a verdict used."""
+    water a verdict used; and the charted ``channels`` (areas and lines, with their
+    attributes and their water navigable for the draught) and their ``channel_axes``
+    (``_channel_layers``; no feature when the chart has none)."""
 
     def geometries(values: Any) -> np.ndarray:
         shapes = chart.frame.shapes_to_wgs84(_multipolygons(values))
@@ -85,6 +109,13 @@ def write_chart_geopackage(path: Path, chart: Chart, draught_m: float, ukc_m: fl
             {"draught_m": np.array([draught_m]), "ukc_m": np.array([ukc_m])},
         ),
     }
+    kinds = dict.fromkeys(layers, "MultiPolygon")
+    if channels is not None and len(navigable) != len(channels):
+        navigable = navigable_widths(channels, draught_m, ukc_m)
+    channel_layers = _channel_layers(channels, navigable, draught_m)
+    for layer, (kind, shapes, fields) in channel_layers.items():
+        layers[layer] = (_wkb(chart.frame.shapes_to_wgs84(shapes)), fields)
+        kinds[layer] = kind
     with atomic_path(path, suffix=".gpkg") as tmp:
         tmp.unlink()  # GDAL creates the GeoPackage itself
         for index, (layer, (wkb, fields)) in enumerate(layers.items()):
@@ -95,11 +126,59 @@ def write_chart_geopackage(path: Path, chart: Chart, draught_m: float, ukc_m: fl
                 list(fields.keys()),
                 layer=layer,
                 driver="GPKG",
-                geometry_type="MultiPolygon",
+                geometry_type=kinds[layer],
                 crs="EPSG:4326",
                 promote_to_multi=True,
                 append=index > 0,
             )
+
+
+def _wkb(shapes: Any) -> np.ndarray:
+    return np.asarray(shapely.to_wkb(np.asarray(shapes, dtype=object)), dtype=object)
+
+
+def _channel_layers(
+    channels: Channels | None, navigable: Sequence[NavigableWidth | None], draught_m: float
+) -> dict[str, tuple[str, np.ndarray, dict[str, np.ndarray]]]:
+    """The ``channels`` layer (areas and lines in one layer of any geometry type) and the
+    ``channel_axes`` layer (MultiLineString), each as (geometry type, shapes in the chart's
+    frame, fields)."""
+    items = list(channels or ())
+
+    def column(values: list[Any], dtype: Any = object) -> np.ndarray:
+        return np.asarray(values, dtype=dtype)
+
+    def number(values: list[float | None]) -> np.ndarray:
+        return np.asarray([np.nan if v is None else v for v in values], dtype=float)
+
+    shared = {
+        "kind": column([str(c.kind) for c in items]),
+        "label": column([c.label for c in items]),
+        "record_id": column([c.record_id for c in items]),
+        "axis_source": column([str(c.axis_source) for c in items]),
+        "axis_deg": number([c.axis_deg for c in items]),
+    }
+    fields = {
+        **shared,
+        "class": column([c.object_class for c in items]),
+        "name": column([c.name for c in items]),
+        "chart": column([c.chart for c in items]),
+        "orient_deg": number([c.orient_deg for c in items]),
+        "traffic": column([None if c.traffic is None else str(c.traffic) for c in items]),
+        "depth_m": number([c.depth_m for c in items]),
+        "depth_max_m": number([c.depth_max_m for c in items]),
+        "category": number([c.category for c in items]),
+        "length_m": number([c.length_m for c in items]),
+        "width_m": number([c.width_m for c in items]),
+        "tracks": column([", ".join(c.tracks) for c in items]),
+        "navigable_share": number([None if n is None else n.share for n in navigable]),
+        "narrowest_navigable_m": number([None if n is None else n.narrowest_m for n in navigable]),
+        "draught_m": np.full(len(items), draught_m),
+    }
+    return {
+        "channels": ("Unknown", column([c.geometry for c in items]), fields),
+        "channel_axes": ("MultiLineString", column([c.axis for c in items]), shared),
+    }
 
 
 @dataclass(frozen=True)
@@ -108,6 +187,7 @@ class ChartSummary:
     navigable_area_km2: float | None
     plot_path: Path | None  # the plot or the GeoPackage written, if any
     text: str
+    channels: Channels | None = None
 
     @property
     def written(self) -> str:
@@ -179,6 +259,43 @@ def format_chart_summary(chart: Chart) -> str:
     return "\n".join(lines) + "\n"
 
 
+def format_channels(
+    channels: Channels,
+    navigable: Sequence[NavigableWidth | None] = (),
+    draught_m: float | None = None,
+) -> str:
+    """The charted channels, one line each: kind, name (else class and record id), axis
+    (ORIENT as charted, else the derived centreline's direction from end to end, true),
+    traffic, least depth, length × mean width, the tracks along it and, for a draught, how
+    much of its axis has water navigable for it and how wide that is at the narrowest."""
+    if len(channels) == 0:
+        return "Channels: none charted\n"
+    areas = sum(c.is_area for c in channels)
+    labels = {c.record_id: c.label for c in channels}
+    lines = [
+        f"Channels: {areas} area(s), {len(channels) - areas} line(s) (axis true; least depth; "
+        "length × mean width)"
+    ]
+    for i, channel in enumerate(channels):
+        axis = "ORIENT" if channel.axis_source is AxisSource.ORIENT else str(channel.axis_source)
+        parts = [f"{axis} {channel.axis_deg:05.1f}°"]
+        if channel.traffic is not None:
+            parts.append(str(channel.traffic))
+        if channel.depth_m is not None:
+            parts.append(f"{channel.depth_m:g} m deep")
+        size = f"{channel.length_m:.0f} m"
+        parts.append(size if channel.width_m is None else f"{size} × {channel.width_m:.0f} m")
+        if channel.tracks:
+            parts.append("along it " + ", ".join(labels.get(t, t) for t in channel.tracks))
+        width = navigable[i] if i < len(navigable) else None
+        if draught_m is not None and width is not None:
+            parts.append(f"navigable for {draught_m:g} m along {width.share:.0%} of its axis")
+            if width.narrowest_m is not None:
+                parts[-1] += f", {width.narrowest_m:.0f} m wide there at the narrowest"
+        lines.append(f"  {channel.kind:<17} {channel.label}: " + ", ".join(parts))
+    return "\n".join(lines) + "\n"
+
+
 def check_chart_out(out: Path | None, draught_m: float | None) -> None:
     """Refuse, before any chart is read, an ``--out`` the command would not write: one
     without ``--draught`` (the plot and the GeoPackage show the water for a draught) or of
@@ -221,20 +338,24 @@ def summarise_chart(
             f"--ukc {ukc_m:g} needs --draught M: the clearance is added to a draught; add --draught"
         )
     check_chart_out(out, draught_m)
-    with progress_bar("Reading charts", 1, progress_enabled(quiet)) as bar:
+    with progress_bar("Reading charts", 2, progress_enabled(quiet)) as bar:
         chart = load_chart(paths, accept_gaps=accept_gaps)
         bar.advance()
-    text = format_chart_summary(chart)
+        channels = load_channels(chart)
+        bar.advance()
     if draught_m is None:
-        return ChartSummary(chart, None, None, text)
+        text = format_chart_summary(chart) + format_channels(channels)
+        return ChartSummary(chart, None, None, text, channels)
+    navigable = navigable_widths(channels, draught_m, ukc_m)
+    text = format_chart_summary(chart) + format_channels(channels, navigable, draught_m)
     area_km2 = chart.navigable_area_km2(draught_m, ukc_m)
     out_path = DEFAULT_REPORTS_DIR / f"chart-{Path(paths[0]).stem}.png" if out is None else out
     if out_path.suffix.lower() == GEOPACKAGE_SUFFIX:
-        write_chart_geopackage(out_path, chart, draught_m, ukc_m)
+        write_chart_geopackage(out_path, chart, draught_m, ukc_m, channels, navigable)
         text += (
             f"Navigable water for draught {draught_m:g} m + UKC {ukc_m:g} m: {area_km2:.3f} km²\n"
         )
-        return ChartSummary(chart, area_km2, out_path, text)
+        return ChartSummary(chart, area_km2, out_path, text, channels)
     plot_path = out_path
     # A bare Figure, not pyplot's: no backend to choose, no figure left open (Agg on save).
     figure = Figure(figsize=(8, 8), layout="constrained")
@@ -250,4 +371,4 @@ def summarise_chart(
     ax.legend(loc="lower right", fontsize="small")
     save_figure(plot_path, figure, dpi=150)
     text += f"Navigable water for draught {draught_m:g} m + UKC {ukc_m:g} m: {area_km2:.3f} km²\n"
-    return ChartSummary(chart, area_km2, plot_path, text)
+    return ChartSummary(chart, area_km2, plot_path, text, channels)

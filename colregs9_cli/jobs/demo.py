@@ -35,9 +35,10 @@ from ..core.replay_results import EncounterOutcome, ReplayResult
 from ..errors import InputFileError, NoDataError
 from ..outputs import FILES_KEY, REPORT_MARKER, check_out_dir, report_directory, write_json
 from ..provenance import run_header
+from ..report.replay_geopackage import Domains
 from ..report.replay_report import ENCOUNTER_DIR
 from ..timebase import DISPLAY_TIME_FORMAT
-from .replay import run_replay
+from .replay import domains_choice, run_replay
 from .simulate import SimulationResult, simulate_scenario
 
 SCENARIO_NAMES: tuple[str, ...] = ("greenhopper_restricted", "greenhopper_not_restricted")
@@ -185,8 +186,10 @@ def run_scenario(
     query: Path,
     quiet: bool = True,
     overrides: dict[str, dict[str, object]] | None = None,
+    domains: Domains = Domains.ALL,
 ) -> ScenarioVerdict:
-    """Simulate one scenario into ``out_dir`` and replay it with its own ship in the own seat."""
+    """Simulate one scenario into ``out_dir`` and replay it with its own ship in the own seat
+    (``domains``: the ship-domain ellipses its report.gpkg holds)."""
     simulation = simulate_scenario(
         scenario_path, out_dir / f"simulate-{scenario_path.stem}.csv", quiet=quiet
     )
@@ -205,6 +208,7 @@ def run_scenario(
         plots=True,
         overrides=overrides,
         quiet=quiet,
+        domains=domains,
     )
     outcome = _own_outcome(replay, own.mmsi, name)
     figure = out_dir / f"{name}.png"
@@ -260,8 +264,11 @@ def run_demo(
     chart: Path = DEFAULT_CHART,
     query: Path = DEFAULT_QUERY,
     overwrite: bool = False,
+    domains: Domains | str = Domains.ALL,
 ) -> DemoResult:
     """Both Greenhopper scenarios: simulate, replay, and the verdicts (module docstring).
+    ``domains``: the ship-domain ellipses of the replays' report.gpkg; all by default, as
+    the paper's figures draw them, red and blue (a few hundred ellipses).
 
     Errors: a missing scenario directory, scenario file, chart or query (``InputFileError``,
     exit 2); an ``out_dir`` that cannot take a report, or, unless ``overwrite``, holds a
@@ -271,6 +278,7 @@ def run_demo(
     it was.
     """
     target = out_dir if out_dir is not None else DEFAULT_OUT_DIR
+    choice = domains_choice(domains)
     _require(scenarios_dir, "--scenarios", "directory")
     _require(chart, "--chart", "file")
     _require(query, "--query", "file")
@@ -279,7 +287,9 @@ def run_demo(
         _require(path, "--scenarios", "file")
     check_out_dir(target, overwrite, command="demo")
     with report_directory(target, overwrite) as staging:
-        staged = tuple(run_scenario(path, staging, chart, query, quiet) for path in paths)
+        staged = tuple(
+            run_scenario(path, staging, chart, query, quiet, domains=choice) for path in paths
+        )
         verdicts = tuple(_moved(verdict, staging, target) for verdict in staged)
         for staged_verdict, verdict in zip(staged, verdicts, strict=True):
             # Each replay read its AIS in the staging directory; its run.json is to name the

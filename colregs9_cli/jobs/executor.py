@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 from ..charts.water import Chart
 from ..core.replay_results import ReplayResult
 from ..progress import ProgressSink
+from ..report.replay_geopackage import Domains
 from ..report.replay_report import write_replay_reports
 from .slabs import PairEvaluator, SlabContext, SlabResult, run_slabs
 
@@ -58,6 +59,7 @@ class Executor(Protocol):
         plots: bool,
         bar: ProgressSink,
         overwrite: bool = False,
+        domains: Domains = Domains.RESTRICTED,
     ) -> tuple[Path, ...]:
         """The report files, written whole (``report.replay_report.write_replay_reports``)."""
         ...
@@ -89,8 +91,9 @@ class LocalExecutor:
         plots: bool,
         bar: ProgressSink,
         overwrite: bool = False,
+        domains: Domains = Domains.RESTRICTED,
     ) -> tuple[Path, ...]:
-        return write_replay_reports(result, chart, plots, bar, overwrite=overwrite)
+        return write_replay_reports(result, chart, plots, bar, overwrite=overwrite, domains=domains)
 
 
 class DaskExecutor:
@@ -131,12 +134,13 @@ class DaskExecutor:
         plots: bool,
         bar: ProgressSink,
         overwrite: bool = False,
+        domains: Domains = Domains.RESTRICTED,
     ) -> tuple[Path, ...]:
         from .dask_run import dask_drawer
 
         drawer = dask_drawer(self._client())
         return write_replay_reports(
-            result, chart, plots, bar, drawer, self._on_cluster, overwrite=overwrite
+            result, chart, plots, bar, drawer, self._on_cluster, overwrite, domains
         )
 
 

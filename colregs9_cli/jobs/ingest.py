@@ -1,17 +1,20 @@
-"""``colregs9 ingest``: AIS files into a Parquet dataset, and reading windows of one back.
+"""``colregs9 ingest``: AIS files into a Parquet dataset (reading windows of one back is
+``ais/dataset_window.py``'s, given here too).
 
 Layout (``OUT`` is the dataset directory)::
 
     OUT/colregs9-dataset.json                       the manifest
     OUT/date=YYYY-MM-DD/part-<sha16>-<n>.parquet    one or more files per input and date
     OUT/date=__HIVE_DEFAULT_PARTITION__/...         static reports whose time does not parse
+    OUT/_dimension_reports/part-<sha16>.parquet     dimension reports outside the query
 
 ``<sha16>`` is the first 16 hex digits of the input file's sha256, ``<n>`` counts the input's
 files in that partition (a new file starts, at an hour boundary, past ``FILE_ROWS``). The
-files hold the canonical schema (``schema.CANONICAL_SCHEMA``, format version 2; the
+files hold the canonical schema (``schema.CANONICAL_SCHEMA``, format version 3; the
 partition gives ``date``), zstd-compressed, in row groups of ``ROW_GROUP_ROWS``. An ingest
-into a version 1 dataset (files without A, B, C, D) adds its inputs so, and records each
-input's version in the manifest, then of version 2 (dataset_scan.py reads both). Within a
+into an older dataset (version 1: files without A, B, C, D; 2: no dimension reports outside
+the query) adds its inputs so, and records each input's version in the manifest, then of
+version 3 (dataset_scan.py reads all three). Within a
 file the positions come first, sorted by (hour of timestamp, floor(lat_deg), floor(lon_deg),
 mmsi, timestamp), so that each row group covers about one hour and a band of latitudes: the
 statistics on timestamp, lat_deg and lon_deg let a time and region query skip most row
@@ -20,18 +23,23 @@ step 4, with null lat/lon), in their own row groups, sorted by (hour, mmsi, time
 ``stats`` counts their dimensions as it does in the files.
 
 The rows are those ``load_ais`` would use under the ingest query (everything by default):
-cleaned the same way, exact duplicates dropped, with the same rejects ledger. Reading the
-dataset with a query gives the positions and ``stats`` that reading the files with that
-query (and the ingest query) gives; the README ("`colregs9 ingest`: datasets") says where
-they differ.
+cleaned the same way, exact duplicates dropped, with the same rejects ledger. The rows the
+query leaves out are not written, but their dimension reports are (every vessel's, counted
+by MMSI, length, breadth and draught as ``load_ais`` counts them: the file's reports less
+those of the rows written), in ``_dimension_reports/``: ``stats`` counts a vessel's reports
+over the whole files, so it finds hers there. Reading the dataset with a query gives the
+positions and ``stats`` that reading the files with that query (and the ingest query) gives;
+the README ("`colregs9 ingest`: datasets") says where they differ.
 
 Ingest streams: each input is read block by block (``load.stream_ais``; NMEA is decoded
 whole) and its rows are spilled to per-hour Arrow files in a staging directory inside
-``OUT``; then each hour is sorted, cleared of duplicates and appended to its date's file,
-so that memory holds about one hour of the input. The input's files are moved into place
-and the manifest rewritten (atomically) only once the whole input is written: an input is
-in the dataset whole, or not at all. An input whose sha256 the manifest already lists is
-skipped.
+``OUT``; once every input is read, each input's hours are sorted, cleared of duplicates and
+appended to their date's file in turn, so that memory holds about one hour of an input (and
+the staging directories hold every input of the ingest). The positions of NMEA inputs first
+take the static fields they lack from the static reports of every NMEA input of the ingest
+(``static_join``: a log split by day). An input's files are moved into place and the
+manifest rewritten (atomically) only once the whole input is written: an input is in the
+dataset whole, or not at all. An input whose sha256 the manifest already lists is skipped.
 """
 
 from __future__ import annotations
@@ -54,35 +62,40 @@ import numpy as np
 import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
-import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 
 from .. import __version__
+from ..ais.counting import PARTS_BEFORE_MERGE
 from ..ais.dataset_scan import (
     DATASET_FORMAT,
     FORMAT_VERSION,
     MANIFEST_NAME,
+    REPORTS_DIR,
     UNDATED,
     Dataset,
     DatasetInput,
     is_dataset,
     manifest_schema,
     ms_date,
-    position_filter,
-    positions_in_query,
     read_manifest,
-    scan_columns,
-    utc_ms,
 )
-from ..ais.duplicates import ROW_ORDER, repeated_rows
+from ..ais.dataset_window import (
+    dataset_time_range,
+    drop_duplicates,
+    read_dataset_window,
+    read_window_counted,
+)
+from ..ais.dimension_reports import NO_REPORTS, rows_reports, sum_counts
 from ..ais.inputs import InputFile, no_positions_error
+from ..ais.layouts import NMEA as NMEA_LAYOUT
 from ..ais.layouts import check_format
 from ..ais.ledger import RejectReason, RejectsLedger
-from ..ais.load import stream_ais
-from ..ais.schema import CANONICAL_COLUMNS, CANONICAL_SCHEMA
+from ..ais.load import StreamedInput, stream_ais
+from ..ais.schema import CANONICAL_SCHEMA
 from ..ais.sources import Source, inspect_source, sha256_file
+from ..ais.static_join import STATIC_COLUMNS, fill_statics
 from ..ais.time_sources import ingest_params
-from ..errors import InputFileError, NoDataError, OutputError, ParameterError
+from ..errors import Colregs9Error, InputFileError, OutputError, ParameterError
 from ..outputs import report_manifest, write_json
 from ..progress import ProgressSink, progress_bar, progress_enabled
 from ..provenance import query_manifest
@@ -235,23 +248,33 @@ def _ingest_locked(
     for source, sha256 in zip(sources, hashes, strict=True):
         if sha256 in known:
             _check_same_query(source.path, known[sha256], query)
-    new = {h: s for s, h in zip(sources, hashes, strict=True) if h not in known}
+    new: dict[str, Source] = {}
+    for source, sha256 in zip(sources, hashes, strict=True):
+        if sha256 not in known:
+            new.setdefault(sha256, source)
     if is_dataset(out_dir):  # as stats and replay check it: no file it does not list
         Dataset.open(out_dir, leftovers=[f"{_prefix(h)}-" for h in new])
+    staged: list[_Staged] = []
+    try:
+        try:
+            total = float(sum(s.size_bytes for s in new.values()))
+            with progress_bar("Reading AIS", total, progress_enabled(quiet), in_bytes=True) as bar:
+                for sha256, source in new.items():
+                    staged.append(_stage(source, sha256, out_dir, query, fmt, bar, refuse_empty))
+        except Colregs9Error:
+            # The inputs before a bad one are ingested, as they would be without it.
+            _install_staged(staged, out_dir, query, entries, row_group_rows, quiet)
+            raise
+        _install_staged(staged, out_dir, query, entries, row_group_rows, quiet)
+    finally:
+        for item in staged:
+            shutil.rmtree(item.staging, ignore_errors=True)
+    by_hash = {entry["sha256"]: entry for entry in entries}
     results = []
-    total = float(sum(s.size_bytes for s in new.values()))
-    with progress_bar("Reading AIS", total, progress_enabled(quiet), in_bytes=True) as bar:
-        for source, sha256 in zip(sources, hashes, strict=True):
-            if sha256 in known:
-                results.append(_already(source.path, known[sha256]))
-                continue
-            entry = _ingest_one(
-                source, sha256, out_dir, query, fmt, bar, row_group_rows, quiet, refuse_empty
-            )
-            entries.append(entry)
-            known[sha256] = entry
-            _write_manifest(out_dir, entries)
-            results.append(_ingested(entry))
+    for source, sha256 in zip(sources, hashes, strict=True):
+        first = new.pop(sha256, None) is not None  # a file given twice is ingested once
+        entry = by_hash[sha256]
+        results.append(_ingested(entry) if first else _already(source.path, entry))
     inputs = tuple(results)
     return IngestResult(out_dir, inputs, _summary(out_dir, inputs, entries))
 
@@ -300,91 +323,176 @@ def _output_error(out_dir: Path, exc: OSError) -> OutputError:
     )
 
 
-def _ingest_one(
+@dataclass(frozen=True)
+class _Staged:
+    """A new input read into its staging directory inside the dataset, to be written."""
+
+    source: Source
+    sha256: str
+    staging: Path
+    spill: _Spill
+    streamed: StreamedInput
+
+
+def _stage(
     source: Source,
     sha256: str,
     out_dir: Path,
     query: Query,
     fmt: str | None,
     bar: ProgressSink,
-    row_group_rows: int,
-    quiet: bool,
-    refuse_empty: bool = False,
-) -> dict[str, Any]:
-    """Read one input into a staging directory, then move its files into the dataset;
-    the manifest entry for it. ``refuse_empty``: ``InputFileError`` for an input without
-    any usable AIS position (none written, none outside the query; static reports alone
-    are none, as ``load_ais`` tells), before anything is moved."""
+    refuse_empty: bool,
+) -> _Staged:
+    """Read one input into a staging directory (removed again if it fails).
+    ``refuse_empty``: ``InputFileError`` for an input without any usable AIS position (none
+    in the query, none outside it; static reports alone are none, as ``load_ais`` tells)."""
     try:
         staging = out_dir / f".ingest-{secrets.token_hex(6)}"
         staging.mkdir()
     except OSError as exc:
         raise _output_error(out_dir, exc) from None
     try:
-        spill = _Spill(staging / "spill")
+        spill = _Spill(staging / "spill", count_reports=not _of_everything(query))
         streamed = stream_ais(source, spill, query, fmt, bar)
         if streamed.sha256 != sha256:
             raise InputFileError(
                 f"{source.name}: the file changed while it was being ingested; ingest it again "
                 "once it is complete"
             )
-        prefix = _prefix(sha256)
-        hours = len(spill.files)
-        with progress_bar("Writing partitions (hours)", hours, progress_enabled(quiet)) as done:
-            written = _write_partitions(
-                spill, staging / "out", prefix, row_group_rows, streamed.ledger, done
-            )
         ledger = streamed.ledger
-        positions = sum(item.rows - item.static_rows for item in written)
-        if refuse_empty and not positions and not ledger.rows_outside_query:
+        if refuse_empty and not spill.position_rows and not ledger.rows_outside_query:
             read = InputFile(source.path, sha256, streamed.layout, ledger.rows_read)
             raise no_positions_error([read], ledger, query)
-        _install(staging / "out", out_dir, prefix, written)
+    except OSError as exc:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise _output_error(out_dir, exc) from None
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    return _Staged(source, sha256, staging, spill, streamed)
+
+
+def _of_everything(query: Query) -> bool:
+    """A query that keeps every row: nothing lies outside it."""
+    return query.region is None and query.time.unbounded and query.vessels.selects_all
+
+
+def _install_staged(
+    staged: Sequence[_Staged],
+    out_dir: Path,
+    query: Query,
+    entries: list[dict[str, Any]],
+    row_group_rows: int,
+    quiet: bool,
+) -> None:
+    """Write the inputs read, one after the other, each moved into the dataset and added
+    to the manifest (``entries``) once whole. The positions of each NMEA input get the
+    static fields they lack from the static reports of all (``static_join``)."""
+    nmea = [item.streamed.layout == NMEA_LAYOUT.name for item in staged]
+    statics = None
+    if sum(nmea) > 1:  # one file's reports were joined to its positions as it was read
+        parts = [
+            item.spill.read("statics", hour).select(STATIC_COLUMNS)
+            for item, is_nmea in zip(staged, nmea, strict=True)
+            if is_nmea
+            for hour in item.spill.hours("statics")
+        ]
+        statics = pa.concat_tables(parts) if parts else None
+    for item, is_nmea in zip(staged, nmea, strict=True):
+        joined = statics if is_nmea else None
+        entries.append(_write_staged(item, out_dir, query, row_group_rows, quiet, joined))
+        _write_manifest(out_dir, entries)
+
+
+def _write_staged(
+    item: _Staged,
+    out_dir: Path,
+    query: Query,
+    row_group_rows: int,
+    quiet: bool,
+    statics: pa.Table | None,
+) -> dict[str, Any]:
+    """Write one input read into its partitions, move its files into the dataset; the
+    manifest entry for it. ``statics``: static reports to join to its positions."""
+    prefix = _prefix(item.sha256)
+    ledger = item.streamed.ledger
+    try:
+        out = item.staging / "out"
+        hours = len(item.spill.files)
+        with progress_bar("Writing partitions (hours)", hours, progress_enabled(quiet)) as done:
+            written = _write_partitions(
+                item.spill, out, prefix, row_group_rows, ledger, done, statics
+            )
+        outside = item.spill.outside_reports(item.streamed.dimension_reports)
+        reports = None
+        if outside.num_rows:
+            reports = {"path": f"{REPORTS_DIR}/{prefix}.parquet", "rows": outside.num_rows}
+            (out / REPORTS_DIR).mkdir(parents=True, exist_ok=True)
+            pq.write_table(outside, out / reports["path"], compression=COMPRESSION)
+        _install(out, out_dir, prefix, written, reports)
     except OSError as exc:
         raise _output_error(out_dir, exc) from None
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
     partitions: dict[str, int] = defaultdict(int)
-    for item in written:
-        partitions[item.date or UNDATED] += item.rows
+    for w in written:
+        partitions[w.date or UNDATED] += w.rows
     return {
-        "path": str(source.path),
-        "format_version": FORMAT_VERSION,  # its files' schema (dataset_scan.FILE_SCHEMAS)
-        "sha256": sha256,
-        "size_bytes": source.size_bytes,
-        "layout": streamed.layout,
+        "path": str(item.source.path),
+        "format_version": FORMAT_VERSION,  # its files (dataset_scan.FILE_SCHEMAS)
+        "sha256": item.sha256,
+        "size_bytes": item.source.size_bytes,
+        "layout": item.streamed.layout,
         "query": query_manifest(query),
-        "rows_read": streamed.ledger.rows_read,
-        "ledger": streamed.ledger.to_dict(),
-        "rows_written": sum(item.rows for item in written),
-        "static_rows": sum(item.static_rows for item in written),
+        "rows_read": ledger.rows_read,
+        "ledger": ledger.to_dict(),
+        "rows_written": sum(w.rows for w in written),
+        "static_rows": sum(w.static_rows for w in written),
         "partitions": dict(sorted(partitions.items())),
         "files": [
             {"path": w.path, "date": w.date, "rows": w.rows, "static_rows": w.static_rows}
             for w in written
         ],
+        "outside_query_reports": reports,
         "ingested_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }
 
 
 class _Spill:
     """The ``RowSink`` of an ingest: each block's rows go to Arrow files, one directory per
-    (kind, hour), so that an hour can be read back alone."""
+    (kind, hour), so that an hour can be read back alone. ``count_reports``: count the
+    dimension reports of the rows handed on, to tell those of the rows the query left out
+    (``outside_reports``)."""
 
-    def __init__(self, directory: Path) -> None:
+    def __init__(self, directory: Path, count_reports: bool) -> None:
         self.directory = directory
         self.files: dict[tuple[str, int], list[Path]] = defaultdict(list)
+        self.position_rows = 0
+        self.count_reports = count_reports
+        self._handed: list[pa.Table] = []  # their dimension reports, counted -1 each
         directory.mkdir()
 
     def positions(self, table: pa.Table) -> None:
+        self.position_rows += table.num_rows
         self._write("positions", table)
 
     def statics(self, table: pa.Table) -> None:
         self._write("statics", table)
 
+    def outside_reports(self, reports: pa.Table) -> pa.Table:
+        """The file's dimension ``reports`` (``StreamedInput.dimension_reports``) less those
+        of the rows handed on: the reports of the rows outside the query, sorted."""
+        if not self.count_reports:
+            return NO_REPORTS
+        outside = sum_counts([reports, *self._handed])
+        outside = outside.filter(pc.not_equal(outside.column("n_reports"), 0))
+        return outside.sort_by([(name, "ascending") for name in outside.column_names])
+
     def _write(self, kind: str, table: pa.Table) -> None:
         if table.num_rows == 0:
             return
+        if self.count_reports:
+            self._handed.append(rows_reports(table, -1))
+            if len(self._handed) >= PARTS_BEFORE_MERGE:
+                self._handed = [sum_counts(self._handed)]
         hours = _hours(table)
         order = np.argsort(hours, kind="stable")
         bounds = np.flatnonzero(np.diff(hours[order])) + 1
@@ -466,9 +574,11 @@ def _write_partitions(
     row_group_rows: int,
     ledger: RejectsLedger,
     bar: ProgressSink,
+    statics: pa.Table | None = None,
 ) -> list[_Written]:
     """Write the spilled rows into date partitions under ``staging``, hour by hour; the
-    positions written are used in ``ledger`` and their duplicates rejected."""
+    positions written are used in ``ledger`` and their duplicates rejected. ``statics``:
+    static reports whose fields the positions lacking them take (``static_join``)."""
     dates: dict[str | None, dict[str, list[int]]] = defaultdict(lambda: defaultdict(list))
     for kind in ("positions", "statics"):
         for hour in spill.hours(kind):
@@ -478,7 +588,10 @@ def _write_partitions(
     for day in sorted(dates, key=lambda d: (d is None, d or "")):
         writer = _PartitionWriter(staging, day, prefix, row_group_rows)
         for hour in dates[day]["positions"]:
-            table, dropped = _drop_duplicates(_sort_for_pruning(spill.read("positions", hour)))
+            table = spill.read("positions", hour)
+            if statics is not None:
+                table = fill_statics(table, statics)
+            table, dropped = drop_duplicates(_sort_for_pruning(table))
             duplicates.add(dropped)
             ledger.use(table.num_rows)
             writer.write(table, static=False)
@@ -549,30 +662,28 @@ def _sort_for_pruning(table: pa.Table) -> pa.Table:
     return table.take(order)
 
 
-def _drop_duplicates(table: pa.Table) -> tuple[pa.Table, pa.Table]:
-    """``table`` without rows equal in every column to an earlier one, and the rows dropped.
-
-    Equal rows share their (mmsi, timestamp), and ``table`` must have those rows next to
-    each other (as both sorts here do): ``duplicates.repeated_rows`` compares only those.
-    """
-    dropped = repeated_rows(table, np.arange(table.num_rows))
-    return table.filter(pa.array(~dropped)), table.filter(pa.array(dropped))
-
-
 def _prefix(sha256: str) -> str:
     """The start of the names of an input's files (``part-<sha16>``)."""
     return f"part-{sha256[:16]}"
 
 
-def _install(staging: Path, out_dir: Path, prefix: str, written: list[_Written]) -> None:
-    """Move the input's files into the dataset, replacing what an interrupted ingest of
-    the same input may have left (its files bear its name but are in no manifest)."""
+def _install(
+    staging: Path,
+    out_dir: Path,
+    prefix: str,
+    written: list[_Written],
+    reports: dict[str, Any] | None,
+) -> None:
+    """Move the input's files (and ``reports``, its dimension reports outside the query)
+    into the dataset, replacing what an interrupted ingest of the same input may have left
+    (its files bear its name but are in no manifest)."""
     for leftover in out_dir.glob(f"date=*/{prefix}-*.parquet"):
         leftover.unlink()
-    for item in written:
-        target = out_dir / item.path
+    paths = [item.path for item in written] + ([reports["path"]] if reports else [])
+    for path in paths:
+        target = out_dir / path
         target.parent.mkdir(exist_ok=True)
-        os.replace(staging / item.path, target)
+        os.replace(staging / path, target)
 
 
 def _write_manifest(out_dir: Path, entries: list[dict[str, Any]]) -> None:
@@ -585,6 +696,8 @@ def _write_manifest(out_dir: Path, entries: list[dict[str, Any]]) -> None:
         "partitioning": {"flavor": "hive", "field": "date", "type": "date32", "null": UNDATED},
         "sort_order": list(SORT_ORDER),
         "static_reports": "after the positions of each file, lat_deg and lon_deg null",
+        "outside_query_reports": f"{REPORTS_DIR}/part-<sha16>.parquet: the dimension reports "
+        "(mmsi, length_m, breadth_m, draught_m, n_reports) of the rows the ingest query left out",
         "compression": COMPRESSION,
         "inputs": entries,
     }
@@ -634,66 +747,3 @@ def _summary(
         f"{out_dir} holds {len(entries)} input(s), {rows} rows in {len(partitions)} partition(s)"
     )
     return "\n".join(lines) + "\n"
-
-
-# -- reading ----------------------------------------------------------------------------------
-
-
-def read_dataset_window(
-    dataset_dir: Path | Dataset,
-    query: Query,
-    start: datetime,
-    end: datetime,
-    columns: Sequence[str] | None = None,
-) -> pa.Table:
-    """The positions of the dataset with ``start <= timestamp < end`` inside ``query``
-    (region, polygon too, time window and vessel filter), sorted by (mmsi, timestamp),
-    exact duplicates dropped; an empty table if there are none.
-
-    ``columns``: the columns of the table (default: all, ``CANONICAL_SCHEMA``). The query,
-    the window and the columns are pushed down into the scan (partitions and row groups
-    skipped, other columns not decoded; all are read where two inputs share a date, to find
-    duplicates). ``dataset_dir`` may be a ``Dataset`` already opened, which saves checking
-    its files again for every window. ``start`` and ``end`` are timezone-aware.
-    """
-    return read_window_counted(dataset_dir, query, start, end, columns)[0]
-
-
-def read_window_counted(
-    dataset_dir: Path | Dataset,
-    query: Query,
-    start: datetime,
-    end: datetime,
-    columns: Sequence[str] | None = None,
-    mmsis: tuple[int, int] | None = None,
-) -> tuple[pa.Table, pa.Table]:
-    """``read_dataset_window``, and the rows in the window and the query that were
-    dropped as exact duplicates (of rows of another input). ``mmsis``: only the vessels
-    with an MMSI in this range (inclusive); a duplicate has its original's MMSI, so the
-    vessels may be read in parts."""
-    dataset = dataset_dir if isinstance(dataset_dir, Dataset) else Dataset.open(dataset_dir)
-    wanted = list(CANONICAL_COLUMNS if columns is None else columns)
-    read = scan_columns(wanted, query) if dataset.duplicate_free else CANONICAL_COLUMNS
-    expression = position_filter(query, utc_ms(start), utc_ms(end))
-    if mmsis is not None:
-        expression &= (ds.field("mmsi") >= mmsis[0]) & (ds.field("mmsi") <= mmsis[1])
-    tables = list(positions_in_query(dataset, query, read, expression))
-    schema = pa.schema([CANONICAL_SCHEMA.field(name) for name in read])
-    table = pa.concat_tables(tables) if tables else schema.empty_table()
-    order = pc.sort_indices(table, sort_keys=ROW_ORDER)
-    table = table.take(order)
-    dropped = table.slice(0, 0)
-    if not dataset.duplicate_free:
-        table, dropped = _drop_duplicates(table)
-    return table.select(wanted), dropped
-
-
-def dataset_time_range(dataset_dir: Path | Dataset) -> tuple[datetime, datetime]:
-    """The first and last timestamps (UTC) of the dataset's positions, from the Parquet
-    row-group statistics alone (no data read). ``NoDataError`` if it holds no position."""
-    dataset = dataset_dir if isinstance(dataset_dir, Dataset) else Dataset.open(dataset_dir)
-    found = dataset.time_range()
-    if found is None:
-        raise NoDataError(f"{dataset.directory}: the dataset holds no positions")
-    first, last = found
-    return first.astimezone(UTC), last.astimezone(UTC)

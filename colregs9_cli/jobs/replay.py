@@ -27,10 +27,12 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from ..ais.inputs import InputFile
 from ..ais.ledger import DropReason, RejectReason, RejectsLedger
+from ..charts.channels import Channels, load_channels
 from ..charts.provenance import charts_manifest
 from ..charts.sources import ChartSource, read_charts
 from ..charts.water import Chart, project_charts
@@ -44,6 +46,7 @@ from ..core.replay_results import (
     ReplayResult,
     pair_outcome,
 )
+from ..core.rule9 import RULES_APPLIED
 from ..core.tracks import REQUIRED_COLUMNS, STATIC_COLUMNS, Tracks, TrackStats, context_s
 from ..errors import ChartError, NoDataError, ParameterError
 from ..geo import LocalFrame
@@ -51,15 +54,18 @@ from ..outputs import check_out_dir
 from ..progress import progress_bar, progress_enabled
 from ..provenance import inputs_manifest, jsonable, query_manifest, run_header
 from ..query import Query, everything_query, load_query
+from ..report.replay_geopackage import Domains
 from ..report.replay_report import format_summary
 from .executor import executor
 from .replay_input import open_replay_input, segment_input_part
 from .replay_params import ReplayParams, ReplayRunParams, replay_params_from_table
 from .slabs import (
     Extent,
+    PairEvaluator,
     Segmentation,
     SlabContext,
     SlabResult,
+    track_vertices,
 )
 
 # The canonical columns a replay reads: those of the reports and the static data.
@@ -208,6 +214,7 @@ def build_manifest(
         "tracks": jsonable(track_stats),
         "counts": jsonable(counts),
         "verdicts": verdict_counts(pairs),
+        "rules_applied": RULES_APPLIED,
     }
 
 
@@ -227,9 +234,11 @@ def run_replay(
     workers: int = 1,
     scheduler: str | None = None,
     scratch_dir: Path | None = None,
+    domains: Domains | str = Domains.RESTRICTED,
 ) -> ReplayResult:
     """Replay ``ais_paths`` and write the reports (see the module docstring); with
-    ``write=False`` nothing is written (the result is in memory only).
+    ``write=False`` nothing is written (the result is in memory only). ``domains``: which
+    ship-domain ellipses report.gpkg holds (all, restricted or none; recorded in run.json).
 
     Errors: an own MMSI not in the data, fewer than two vessels (``NoDataError``, exit 3); a
     chart that covers none of the AIS (``ChartError``, exit 2); bad files or parameters. A run
@@ -240,13 +249,7 @@ def run_replay(
     temporary directory). ``workers`` > 1 runs the slabs on a local Dask cluster of that many
     processes, ``scheduler`` on the Dask cluster at that address (``executor.py``).
     """
-    if workers < 1:
-        raise ParameterError(f"--workers {workers}: give 1 or more worker processes")
-    if scratch_dir is not None and not Path(scratch_dir).is_dir():
-        raise ParameterError(
-            f"--scratch {scratch_dir}: not a directory; give an existing directory (on a "
-            "multi-machine cluster, one that every worker mounts)"
-        )
+    domains = _checked_options(workers, scratch_dir, domains)
     with executor(workers, scheduler, scratch_dir) as runner:
         query = load_query(query_path) if query_path is not None else everything_query()
         params = run_params(query, own_mmsi, overrides)
@@ -290,10 +293,11 @@ def run_replay(
                 results = runner.replay_slabs(
                     slabs,
                     slab_context(segmentation, frame, params),
-                    functools.partial(_evaluate, params=params.pair),
+                    _pair_evaluator(params.pair, chart),
                     chart,
                     bar,
                 )
+            vessel_tracks = _vessel_tracks(segmentation)  # before the spill goes
         counts = _counts(segmentation, results)
         outcomes = tuple(pair for result in results for pair in result.pairs)
         manifest = build_manifest(
@@ -309,6 +313,7 @@ def run_replay(
             outcomes,
             accept_chart_gaps,
         )
+        manifest["parameters"]["domains"] = domains.value
         manifest["slabs"] = {
             "slab_s": params.replay.slab_s,
             "slabs": len(slabs),
@@ -324,12 +329,53 @@ def run_replay(
             counts=counts,
             manifest=manifest,
             files=(),
+            vessel_tracks=vessel_tracks,
         )
         files: tuple[Path, ...] = ()
         if write:
             with progress_bar("Reports", len(result.encounters), progress_enabled(quiet)) as bar:
-                files = runner.write_reports(result, chart, plots, bar, overwrite)
+                files = runner.write_reports(result, chart, plots, bar, overwrite, domains)
         return dataclasses.replace(result, files=files, text=format_summary(result))
+
+
+def _checked_options(workers: int, scratch_dir: Path | None, domains: Domains | str) -> Domains:
+    """The options checked before any work; ``domains`` as a ``Domains``."""
+    if workers < 1:
+        raise ParameterError(f"--workers {workers}: give 1 or more worker processes")
+    if scratch_dir is not None and not Path(scratch_dir).is_dir():
+        raise ParameterError(
+            f"--scratch {scratch_dir}: not a directory; give an existing directory (on a "
+            "multi-machine cluster, one that every worker mounts)"
+        )
+    return domains_choice(domains)
+
+
+def domains_choice(value: Domains | str) -> Domains:
+    """``--domains`` as a ``Domains``; another value is a ``ParameterError``."""
+    try:
+        return Domains(value)
+    except ValueError:
+        choices = ", ".join(d.value for d in Domains)
+        raise ParameterError(f"--domains {value!r} is not one of {choices}") from None
+
+
+def _vessel_tracks(segmentation: Segmentation) -> pd.DataFrame:
+    """Every vessel's track (``slabs.track_vertices``) with her name, ship type and length
+    from her static reports, as categories: a few bytes a vertex."""
+    vertices = track_vertices(segmentation.spill)
+    mmsi = vertices["mmsi"].to_numpy()
+    new_vessel = np.diff(mmsi, prepend=-1) != 0
+    # Per vessel, then spread by code: the static table spread over millions of vertices
+    # would take gigabytes.
+    vessel = np.cumsum(new_vessel) - 1
+    statics = segmentation.statics.reindex(mmsi[new_vessel])
+    for name in ("name", "ship_type", "length_m"):
+        values = statics[name] if name in statics.columns else pd.Series(index=statics.index)
+        per_vessel = pd.Categorical(values.to_numpy())
+        vertices[name] = pd.Categorical.from_codes(
+            per_vessel.codes[vessel], categories=per_vessel.categories
+        )
+    return vertices
 
 
 def _charts_near(
@@ -360,15 +406,25 @@ def _scratch_directory(parent: Path | None) -> Iterator[str]:
         yield path
 
 
+def _pair_evaluator(params: PairParams, chart: Chart | None) -> PairEvaluator:
+    """``_evaluate`` with the run's parameters and the chart's channels, these without the
+    chart they were read from (the pairs' facts need no navigable width), so that a task
+    carries kilobytes, not the chart again."""
+    channels = None if chart is None else dataclasses.replace(load_channels(chart), chart=None)
+    return functools.partial(_evaluate, params=params, channels=channels)
+
+
 def _evaluate(
     tracks: Tracks,
     encounter: Encounter,
     seats: tuple[int, ...],
     chart: Chart | None,
     params: PairParams,
+    channels: Channels | None,
 ) -> PairOutcome:
     """One triggered pair's outcome: evaluated once, then projected onto its reported seats."""
-    return pair_outcome(evaluate_pair(tracks, encounter, chart, params), seats, tracks.frame)
+    evaluation = evaluate_pair(tracks, encounter, chart, params, channels)
+    return pair_outcome(evaluation, seats, tracks.frame)
 
 
 def slab_range(segmentation: Segmentation, params: ReplayParams) -> list[int]:

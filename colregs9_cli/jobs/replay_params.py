@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 from ..config import dataclass_from_table
 from ..core.ais_claims import NavStatusParams
 from ..core.audit import ConductParams
+from ..core.channel_audit import ChannelAuditParams
 from ..core.colregs import ColregsParams
 from ..core.encounters import EncounterParams
 from ..core.interactions import InteractionParams
@@ -116,6 +117,11 @@ class ReplayParams:
     company_course_deg: float = 20.0
     company_drift_m: float = 30.0
     company_drift_frac: float = 0.25
+    channel_along_within_deg: float = 30.0
+    channel_crossing_from_deg: float = 45.0
+    starboard_side_share: float = 0.8
+    starboard_side_min_s: float = 30.0
+    lane_crossing_within_deg: float = 15.0
 
     @property
     def tracks(self) -> TrackParams:
@@ -136,6 +142,10 @@ class ReplayParams:
         return _stage_part(self, InteractionParams)
 
     @property
+    def channels(self) -> ChannelAuditParams:
+        return _stage_part(self, ChannelAuditParams)
+
+    @property
     def passing(self) -> PassingParams:
         return PassingParams(self.passing_open_m, self.passing_open_frac, self.passing_follow_s)
 
@@ -151,6 +161,7 @@ class ReplayParams:
 
     def __post_init__(self) -> None:
         _stage_part(self, InteractionParams)  # checks its own keys
+        _stage_part(self, ChannelAuditParams)
         positive = (
             "step_s",
             "max_gap_s",
@@ -265,4 +276,5 @@ class ReplayRunParams:
             passing=self.replay.passing,
             interactions=self.replay.interactions,
             claims=NavStatusParams(),
+            channels=self.replay.channels,
         )

@@ -1,10 +1,12 @@
 """Scenario files for ``colregs9 simulate``: a strict TOML model and its plausibility check.
 
 A scenario names a start time, a duration, an integration step and an AIS reporting
-interval, an optional chart, and ``[[vessel]]`` entries, each with its static data and a
-route of waypoints (lat, lon) with a speed per leg. The format is documented in
-``colregs9_cli/data/demo/README.md``. Every key is checked: unknown or missing keys, wrong types
-and impossible values raise ``QueryError`` naming the file, the vessel and the key.
+interval, an optional chart, and ``[[vessel]]`` entries, each with its static data, a
+route of waypoints (lat, lon) with a speed per leg and an optional time at which she leaves
+her first waypoint (``depart_s``: a ferry at her berth, a ship at anchor). The format is
+documented in ``colregs9_cli/data/demo/README.md``. Every key is checked: unknown or missing
+keys, wrong types and impossible values raise ``QueryError`` naming the file, the vessel and
+the key.
 
 The plausibility check puts every waypoint and every leg of every route in water navigable
 for that vessel's draught on the scenario's chart (``charts.water.load_chart(...).navigable_water``:
@@ -15,6 +17,8 @@ from __future__ import annotations
 
 import datetime as dt
 import math
+import os
+import stat
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
@@ -54,8 +58,9 @@ _VESSEL_KEYS = {
     "imo": int,
     "route": list,
     "speed_kn": object,
+    "depart_s": float,
 }
-_OPTIONAL_VESSEL_KEYS = frozenset({"role", "imo"})
+_OPTIONAL_VESSEL_KEYS = frozenset({"role", "imo", "depart_s"})
 # A vessel's dimensions are held to what ships have, as AIS input is (``ais.clean``), and her
 # speed to what AIS can report (SOG 102.2 kn; 102.3 means "not available").
 DIMENSION_LIMITS_M = {
@@ -76,7 +81,9 @@ class VesselRole(StrEnum):
 
 @dataclass(frozen=True)
 class VesselSpec:
-    """One simulated vessel: static data and a route with one speed per leg."""
+    """One simulated vessel: static data and a route with one speed per leg. She lies at
+    her first waypoint until ``depart_s`` (seconds after the start; 0: she sets off at once,
+    ``duration_s`` or more: she never does)."""
 
     role: VesselRole
     mmsi: int
@@ -90,6 +97,7 @@ class VesselSpec:
     imo: int | None
     route: tuple[tuple[float, float], ...]  # (lat_deg, lon_deg) waypoints
     speed_kn: tuple[float, ...]  # one per leg
+    depart_s: float = 0.0
 
     @property
     def label(self) -> str:
@@ -214,7 +222,8 @@ def _speeds(value: Any, legs: int, where: str) -> tuple[float, ...]:
         if speed <= 0.0:
             raise QueryError(
                 f"{where}: speed_kn = {speed!r} on leg {leg} (waypoint {leg} to {leg + 1}) "
-                "must be positive; a vessel that stops ends its route"
+                "must be positive; a vessel stops at the end of her route, and lies at her "
+                "first waypoint until depart_s"
             )
     return speeds
 
@@ -252,6 +261,12 @@ def _vessel(table: Any, index: int, source: Path) -> VesselSpec:
             f"{where}: key 'nav_status' = {values['nav_status']!r}; give an ITU code 0–15"
         )
     route = _route(values["route"], where)
+    depart_s = values.get("depart_s", 0.0)
+    if depart_s < 0.0:
+        raise QueryError(
+            f"{where}: key 'depart_s' = {depart_s:g} is before the start; give the seconds "
+            "after start_utc at which she leaves her first waypoint (0 or more)"
+        )
     return VesselSpec(
         role=VesselRole(role_text),
         mmsi=values["mmsi"],
@@ -265,6 +280,7 @@ def _vessel(table: Any, index: int, source: Path) -> VesselSpec:
         imo=values.get("imo"),
         route=route,
         speed_kn=_speeds(values["speed_kn"], len(route) - 1, where),
+        depart_s=depart_s,
     )
 
 
@@ -324,12 +340,7 @@ def load_scenario(path: Path) -> Scenario:
         raise QueryError(f"{where}: MMSI {duplicated[0]} is used by two vessels; give each its own")
     if sum(v.role is VesselRole.OWN for v in vessels) > 1:
         raise QueryError(f"{where}: more than one vessel has role = 'own'; give at most one")
-    chart = (path.parent / values["chart"]).resolve() if "chart" in values else None
-    if chart is not None and chart.exists() and not chart.is_file():
-        raise QueryError(
-            f"{where}: chart = {values['chart']!r} is {chart}, a directory, not a file; give "
-            "the chart file (S-57 .000, GeoJSON or GeoPackage)"
-        )
+    chart = _chart_path(path, values["chart"]) if "chart" in values else None
     return Scenario(
         name=values["name"],
         description=values["description"],
@@ -341,6 +352,28 @@ def load_scenario(path: Path) -> Scenario:
         vessels=vessels,
         source=path,
     )
+
+
+def _chart_path(path: Path, relative: str) -> Path:
+    """The scenario's chart, relative to its file. realpath leaves a symbolic link that loops
+    as it is (``Path.resolve`` raises), so that ``stat`` reports it."""
+    where = str(path)
+    chart = Path(os.path.realpath(path.parent / relative))
+    try:
+        mode = chart.stat().st_mode
+    except FileNotFoundError:
+        return chart  # said where the chart is read, with the other chart errors
+    except OSError as exc:
+        raise QueryError(
+            f"{where}: chart = {relative!r}: {exc.strerror}; give the path of a chart file"
+        ) from None
+    if not stat.S_ISREG(mode):
+        what = "a directory, not a file" if stat.S_ISDIR(mode) else "not a regular file"
+        raise QueryError(
+            f"{where}: chart = {relative!r} is {chart}, {what}; give the chart file (S-57 "
+            ".000, GeoJSON or GeoPackage)"
+        )
+    return chart
 
 
 def scenario_frame(scenario: Scenario) -> LocalFrame:

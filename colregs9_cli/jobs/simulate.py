@@ -8,8 +8,10 @@ emitted every ``ais_interval_s`` from the start, for ``0 <= t < duration_s``.
 
 - COG is the course of the current leg (true degrees, one decimal), Heading is COG rounded,
   SOG the leg speed, ROT 0 (legs are straight; turns at waypoints are instantaneous).
-- At the end of her route a vessel stops there: she keeps reporting her last position with
-  SOG 0 and the course of her last leg, so every vessel has the same number of reports.
+- Until ``depart_s`` a vessel lies at her first waypoint, reporting it with SOG 0 and the
+  course of her first leg; her route starts then. At the end of her route she stops there:
+  she keeps reporting her last position with SOG 0 and the course of her last leg, so every
+  vessel has the same number of reports.
 - Static data comes with every report, as in the DMA files: A = B = length/2,
   C = D = breadth/2, Width, Length, Draught, Ship type, Name, Callsign, IMO ("Unknown" if
   none), "Class A", position fixing device "GPS".
@@ -93,13 +95,15 @@ def simulate_vessel(vessel: VesselSpec, frame: LocalFrame, times_s: np.ndarray) 
     leg_m = np.hypot(d_north, d_east)
     leg_speed_mps = knots_to_mps(vessel.speed_kn)
     leg_course_deg = wrap_deg(np.degrees(np.arctan2(d_east, d_north)))
-    waypoint_time_s = np.concatenate([[0.0], np.cumsum(leg_m / leg_speed_mps)])
+    waypoint_time_s = vessel.depart_s + np.concatenate([[0.0], np.cumsum(leg_m / leg_speed_mps)])
 
     leg = np.clip(np.searchsorted(waypoint_time_s, times_s, side="right") - 1, 0, len(leg_m) - 1)
     arrived = times_s >= waypoint_time_s[-1]
+    waiting = times_s < vessel.depart_s
     fraction = np.where(
         arrived, 1.0, (times_s - waypoint_time_s[leg]) * leg_speed_mps[leg] / leg_m[leg]
     )
+    fraction = np.where(waiting, 0.0, fraction)
     north = north_m[leg] + fraction * d_north[leg]
     east = east_m[leg] + fraction * d_east[leg]
     lat_deg, lon_deg = frame.to_geodetic(north, east)
@@ -110,7 +114,7 @@ def simulate_vessel(vessel: VesselSpec, frame: LocalFrame, times_s: np.ndarray) 
         east_m=east,
         lat_deg=lat_deg,
         lon_deg=lon_deg,
-        sog_kn=np.where(arrived, 0.0, np.asarray(vessel.speed_kn)[leg]),
+        sog_kn=np.where(arrived | waiting, 0.0, np.asarray(vessel.speed_kn)[leg]),
         # AIS reports true COG; the leg's direction in the frame is a grid bearing.
         cog_deg=frame.grid_to_true_deg(leg_course_deg[leg], lat_deg, lon_deg),
     )

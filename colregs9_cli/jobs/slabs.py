@@ -46,6 +46,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -113,6 +114,90 @@ class Spill:
         frame = ds.dataset(paths, format="parquet").to_table(filter=wanted).to_pandas()
         order = np.lexsort((frame["t_s"].to_numpy(), frame["mmsi"].to_numpy()))
         return frame.iloc[order].reset_index(drop=True)
+
+
+# A vessel track (``track_vertices``) keeps one decided report in each slot of this many
+# seconds of the UTC grid, and each piece's first and last: Class A ships report every
+# 2–10 s under way, and in 10 s a 20 kn ship makes 100 m, a straight line on any chart.
+TRACK_VERTEX_SLOT_S = 10.0
+TRACK_VERTEX_COLUMNS: tuple[str, ...] = ("mmsi", "piece", "t_s", "lat_deg", "lon_deg", "reports")
+
+
+def _vertex_choice(
+    t_s: NDArray[np.float64], starts: NDArray[np.bool_], slot_s: float
+) -> NDArray[np.bool_]:
+    """Of reports sorted by vessel and time, cut into pieces at ``starts`` (each vessel's
+    first included): the first of each piece in each slot of ``slot_s`` seconds, and each
+    piece's last."""
+    slot = np.floor(t_s / slot_s)
+    first = starts.copy()
+    first[1:] |= slot[1:] != slot[:-1]
+    return first | np.r_[starts[1:], True]
+
+
+def _starts(mmsi: NDArray[np.int64], segment_start: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Where pieces start in decided reports sorted by vessel and time: at a segment's
+    start, and at each vessel's first report here."""
+    return segment_start | np.r_[True, mmsi[1:] != mmsi[:-1]]
+
+
+# What a track's vertices are read from, in the spill files.
+_VERTEX_SOURCE: tuple[str, ...] = ("mmsi", "t_s", "lat_deg", "lon_deg", "segment_start")
+
+
+def _vertex_candidates(path: Path, slot_s: float) -> dict[str, NDArray[Any]]:
+    """Of one spill file's decided reports (sorted by MMSI and time), the columns of those
+    that may be a vertex of their track (``_vertex_choice`` within the file), and
+    ``reports``: how many of the file's reports from each up to the next. Every vertex of
+    the whole spill is among them: a piece's first report in a slot, or its last, is that
+    in its file too."""
+    table = pq.read_table(path, columns=list(_VERTEX_SOURCE))
+    kept = {name: table.column(name).to_numpy() for name in _VERTEX_SOURCE}
+    chosen = np.flatnonzero(
+        _vertex_choice(kept["t_s"], _starts(kept["mmsi"], kept["segment_start"]), slot_s)
+    )
+    found = {name: values[chosen] for name, values in kept.items()}
+    found["reports"] = np.diff(np.r_[chosen, len(kept["t_s"])])
+    return found
+
+
+def track_vertices(spill: Spill, slot_s: float = TRACK_VERTEX_SLOT_S) -> pd.DataFrame:
+    """Every vessel's track over the run, from the decided reports of ``spill``: its
+    pieces (``piece`` 0, 1, … in time order; a new piece at each segment start, where
+    segmentation split the track at a gap or a confirmed jump), each thinned to its first
+    decided report in each ``slot_s`` seconds of the UTC grid and its last
+    (``TRACK_VERTEX_COLUMNS``, sorted by MMSI and time). ``reports``: how many decided
+    reports from each vertex up to the next of its piece (their sum: all the decided
+    reports). Read file by file, keeping the candidates of each (``_vertex_candidates``):
+    the same vertices for any slab length and any parts of the vessels."""
+    found = [_vertex_candidates(f.path, slot_s) for f in spill.files]
+    if not found:
+        empty = _empty_kept().assign(piece=np.zeros(0, dtype=np.int64))
+        return empty.assign(reports=np.zeros(0, dtype=np.int64))[list(TRACK_VERTEX_COLUMNS)]
+    # Column by column, each file's part let go once joined, then sorted: a national day
+    # has millions of candidates, and a whole table more at a time would double them.
+    columns = {name: np.concatenate([part.pop(name) for part in found]) for name in list(found[0])}
+    order = np.lexsort((columns["t_s"], columns["mmsi"]))
+    for name in columns:
+        columns[name] = columns[name][order]
+    mmsi = columns["mmsi"]
+    starts = _starts(mmsi, columns.pop("segment_start"))
+    chosen = _vertex_choice(columns["t_s"], starts, slot_s)
+    # A dropped candidate's reports go to the vertex before it (in its piece: a piece's
+    # first report is always a vertex).
+    reports = np.bincount(np.cumsum(chosen) - 1, weights=columns.pop("reports"))
+    piece = np.cumsum(starts) - 1
+    first_of_vessel = np.flatnonzero(np.r_[True, mmsi[1:] != mmsi[:-1]])
+    piece -= np.repeat(piece[first_of_vessel], np.diff(np.r_[first_of_vessel, len(mmsi)]))
+    return pd.DataFrame(
+        {
+            "mmsi": mmsi[chosen],
+            "piece": piece[chosen],
+            **{name: columns.pop(name)[chosen] for name in ("t_s", "lat_deg", "lon_deg")},
+            "reports": reports.astype(np.int64),
+        },
+        copy=False,  # the arrays are new: no second copy of each
+    )
 
 
 def _empty_kept() -> pd.DataFrame:
@@ -368,8 +453,10 @@ class SlabResult:
 
 def tail_steps(params: ReplayParams) -> int:
     """How far past its core a slab's window reaches: a trigger at the end of the core, its
-    TCPA (at most TCPA_act), the passing followed past it, and a minute."""
-    return math.ceil((params.tcpa_act_s + params.passing_follow_s + 60.0) / params.step_s)
+    TCPA (at most TCPA_act), the passing followed past it or the interaction's window past
+    it (``interactions.approach_steps``), whichever is longer, and a minute."""
+    after_s = max(params.passing_follow_s, params.interactions.interaction_window_s)
+    return math.ceil((params.tcpa_act_s + after_s + 60.0) / params.step_s)
 
 
 def lead_steps(params: ReplayParams) -> int:

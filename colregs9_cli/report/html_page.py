@@ -38,7 +38,13 @@ p.inputs { margin: 0.3em 0 0.8em; }
 section.encounter { border-top: 1px solid #ccc; padding-top: 0.5em; }
 dl.facts { display: grid; grid-template-columns: max-content auto; gap: 2px 12px; }
 dl.facts dt { font-weight: 600; } dl.facts dd { margin: 0; }
-img.figure { max-width: 100%; border: 1px solid #ddd; }
+img.figure { max-width: 100%; border: 1px solid #ddd; display: block; margin: 0.5em 0; }
+div.timeline { max-width: 100%; overflow-x: auto; }
+table.timeline { font-size: 12px; }
+table.timeline th { cursor: default; position: static; white-space: normal; }
+table.timeline td:nth-child(2) { white-space: normal; min-width: 9em; }
+table.timeline tr.event td { background: #fff4d6; font-weight: 600; }
+p.rules { font-size: 13px; color: #444; }
 .missing { color: #a00; font-style: italic; }
 .map svg { max-width: 100%; height: auto; }
 """

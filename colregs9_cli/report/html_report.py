@@ -22,8 +22,10 @@ from matplotlib.figure import Figure
 from ..core.colregs import Role
 from ..core.replay_results import EncounterOutcome, ReplayResult
 from ..core.rows import EncounterSummary, situation_or_interaction
+from ..core.rule9 import RULES_APPLIED
 from ..timebase import DISPLAY_TIME_FORMAT
 from .chart_plot import Bounds, draw_chart, geographic_axes, show_view
+from .dossier import timeline_html
 from .html_page import cell_text, file_links, page, sortable_table
 
 if TYPE_CHECKING:
@@ -372,6 +374,7 @@ def replay_html(
     plots: bool,
     encounter_dir: str,
     files: Sequence[str],
+    motion_suffix: str,
 ) -> str:
     """The replay's index.html (see the module docstring); ``files`` are the report's other
     files written beside it, linked from the top."""
@@ -380,6 +383,7 @@ def replay_html(
     body = [
         f"<h1>{html.escape(title)}</h1>",
         _first_line(result),
+        f'<p class="rules">{html.escape(RULES_APPLIED)}</p>',
         f"<p>{counts.vessels} vessels; {counts.encounters} encounters, {counts.triggered} "
         f"triggered (CPA &lt; {result.params.encounters.cpa_req_m:g} m within 0 ≤ TCPA ≤ "
         f"{result.params.encounters.tcpa_act_s:g} s) in {counts.triggered_pairs} pairs; "
@@ -408,14 +412,21 @@ def replay_html(
         body.append(f"<h3>{html.escape(identifier)}</h3>")
         if plots:
             # Lazy: a report of hundreds of figures loads each as it is scrolled to.
+            figure = f"{encounter_dir}/{html.escape(identifier)}"
             body.append(
-                f'<img class="figure" src="{encounter_dir}/{html.escape(identifier)}.png" '
-                f'alt="figure of {html.escape(identifier)}" loading="lazy">'
+                f'<img class="figure" src="{figure}.png" '
+                f'alt="map of {html.escape(identifier)}" loading="lazy">'
+            )
+            body.append(
+                f'<img class="figure" src="{figure}{motion_suffix}" '
+                f'alt="range and relative motion of {html.escape(identifier)}" loading="lazy">'
             )
         body.append(
-            f'<p><a href="{encounter_dir}/{html.escape(identifier)}.csv">time series (CSV)</a>'
-            ' · <a href="#encounters">back to the table</a></p>'
+            f'<p><a href="{encounter_dir}/{html.escape(identifier)}.csv">time series (CSV, '
+            'every second)</a> · <a href="#encounters">back to the table</a></p>'
         )
+        body += timeline_html(outcome)
+        body.append(f"<h4>Facts of {html.escape(identifier)}</h4>")
         body += _facts(outcome)
         body.append("</section>")
     return page(title, body)

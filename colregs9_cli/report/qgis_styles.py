@@ -6,6 +6,13 @@ dark orange and the target black, restricted ellipses red and clear ones blue (o
 only), the navigable water outlined green. Each style is a QML document with one renderer
 (``renderer-v2``), single-symbol or categorized on a field of the layer; GDAL does not know
 the table, so it is added with SQLite after GDAL has written the layers.
+
+``vessel_tracks`` comes with its Temporal Controller settings (each piece shown from its
+``start_utc`` to its ``end_utc``) and two geometry-generator layers over its grey line, made
+from the M values (epoch seconds) of its vertices at the animation frame's end: the track
+sailed so far, and a marker at the vessel's position, interpolated between the two vertices
+around that time. The expressions use only functions QGIS has had since 3.16 (checked with
+QGIS 3.22, Debian 12's).
 """
 
 from __future__ import annotations
@@ -24,7 +31,25 @@ RESTRICTED_RGBA = "214,39,40,255"
 CLEAR_RGBA = "31,119,180,255"
 UNKNOWN_RGBA = "127,127,127,255"
 WATER_RGBA = "0,200,83,255"
+VESSEL_RGBA = "0,110,120,255"
+PAST_RGBA = "160,160,160,255"
 TRANSPARENT = "0,0,0,0"
+
+# The vertices of a vessel_tracks piece, and the time at the end of the animation frame in
+# epoch seconds (NULL when the Temporal Controller is off: nothing is generated).
+_VERTICES = "array_foreach(generate_series(1, num_points($geometry)), point_n($geometry, @element))"
+_FRAME_END_S = "epoch(@map_end_time) / 1000"
+SAILED_SO_FAR = f"make_line(array_filter({_VERTICES}, m(@element) <= {_FRAME_END_S}))"
+# With k vertices at or before the frame's end: between the k-th and the next, in
+# proportion to the time, or the last vertex once the piece has ended.
+POSITION_AT_FRAME = (
+    f"with_variable('t', {_FRAME_END_S}, with_variable('v', {_VERTICES}, "
+    "with_variable('k', array_length(array_filter(@v, m(@element) <= @t)), "
+    "if(@k < 1, NULL, if(@k >= array_length(@v), @v[-1], "
+    "line_interpolate_point(make_line(@v[@k - 1], @v[@k]), "
+    "length(make_line(@v[@k - 1], @v[@k])) * (@t - m(@v[@k - 1])) "
+    "/ (m(@v[@k]) - m(@v[@k - 1]))))))))"
+)
 
 
 @dataclass(frozen=True)
@@ -35,6 +60,9 @@ class Symbol:
     colour: str
     dashed: bool = False
     marker: str = "circle"
+    width: str = "0.5"
+    # Geometry-generator layers drawn over this one: (expression, symbol of its geometry).
+    generated: Sequence[tuple[str, Symbol]] = ()
 
     def qml(self, name: str) -> str:
         if self.kind == "marker":
@@ -52,7 +80,7 @@ class Symbol:
                 "SimpleLine",
                 {
                     "line_color": self.colour,
-                    "line_width": "0.5",
+                    "line_width": self.width,
                     "line_style": "dash" if self.dashed else "solid",
                 },
             )
@@ -71,11 +99,20 @@ class Symbol:
             f'<Option type="QString" name={quoteattr(k)} value={quoteattr(v)}/>'
             for k, v in options.items()
         )
+        generators = "".join(
+            '<layer class="GeometryGenerator" enabled="1" locked="0" pass="0">'
+            '<Option type="Map">'
+            f'<Option type="QString" name="SymbolType" value="{symbol.kind.title()}"/>'
+            f'<Option type="QString" name="geometryModifier" value={quoteattr(expression)}/>'
+            '<Option type="QString" name="units" value="MapUnit"/></Option>'
+            f"{symbol.qml(f'@{name}@{i}')}</layer>"
+            for i, (expression, symbol) in enumerate(self.generated, start=1)
+        )
         return (
             f'<symbol type="{self.kind}" name={quoteattr(name)} alpha="1" clip_to_extent="1" '
             'force_rhr="0">'
             f'<layer class="{layer_class}" enabled="1" locked="0" pass="0">'
-            f'<Option type="Map">{option_lines}</Option></layer></symbol>'
+            f'<Option type="Map">{option_lines}</Option></layer>{generators}</symbol>'
         )
 
 
@@ -88,6 +125,8 @@ class Style:
     symbol: Symbol | None = None
     field: str | None = None
     categories: Sequence[tuple[str, str, Symbol]] = ()
+    # The Temporal Controller's "separate fields for start and end date/time" (QGIS's mode 2).
+    start_end_fields: tuple[str, str] | None = None
 
     def qml(self) -> str:
         if self.field is None:
@@ -109,9 +148,18 @@ class Style:
                 f"<categories>{categories}</categories><symbols>{symbols}</symbols>"
                 "</renderer-v2>"
             )
+        temporal = ""
+        if self.start_end_fields is not None:
+            start, end = self.start_end_fields
+            temporal = (
+                f'<temporal enabled="1" mode="2" startField={quoteattr(start)} '
+                f'endField={quoteattr(end)} accumulate="0" limitMode="0">'
+                "<fixedRange><start></start><end></end></fixedRange></temporal>"
+            )
+        categories = "Symbology|Temporal" if temporal else "Symbology"
         return (
             "<!DOCTYPE qgis PUBLIC 'http://mrcc.com/qgis.dtd' 'SYSTEM'>"
-            f'<qgis version="3.28.0" styleCategories="Symbology">{renderer}</qgis>'
+            f'<qgis version="3.28.0" styleCategories="{categories}">{temporal}{renderer}</qgis>'
         )
 
 
@@ -154,6 +202,21 @@ STYLES: tuple[Style, ...] = (
         ),
     ),
     Style(
+        "vessel_tracks",
+        "every vessel's track, grey; animated by the Temporal Controller: the track sailed "
+        "so far and the vessel's position",
+        symbol=Symbol(
+            "line",
+            PAST_RGBA,
+            width="0.3",
+            generated=(
+                (SAILED_SO_FAR, Symbol("line", VESSEL_RGBA)),
+                (POSITION_AT_FRAME, Symbol("marker", VESSEL_RGBA)),
+            ),
+        ),
+        start_end_fields=("start_utc", "end_utc"),
+    ),
+    Style(
         "navigable_water",
         "navigable water for the draught, outlined green",
         symbol=Symbol("fill", WATER_RGBA),
@@ -163,7 +226,8 @@ STYLES: tuple[Style, ...] = (
 
 def add_layer_styles(path: Path, layers: Sequence[str]) -> None:
     """Store the default style of each of ``layers`` in the GeoPackage at ``path``."""
-    now = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
+    # GeoPackage DATETIME: with milliseconds, else GDAL warns "Non-conformant content".
+    now = datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%S.000Z")
     with closing(sqlite3.connect(path)) as db, db:
         db.execute(
             "CREATE TABLE IF NOT EXISTS layer_styles ("

@@ -10,9 +10,20 @@ Layers (each only when it has features):
 - ``tracks``: each vessel's track over the encounter, a line per vessel and encounter;
 - ``cpa``: each vessel's position predicted at TCPA from the trigger;
 - ``domains``: the target's ship-domain ellipses at the trigger, with ``restricted`` and
-  ``covered`` (booleans), ``state`` (restricted, clear or unknown), ``arc`` and ``step``;
+  ``covered`` (booleans), ``state`` (restricted, clear or unknown), ``arc`` and ``step``:
+  all of them, only the restricted ones (the default: those an auditor checks against the
+  chart; 3,907 of the San Diego fixture's 13,680) or none (``Domains``);
+- ``vessel_tracks``: every vessel's track over the run (``ReplayResult.vessel_tracks``), a
+  line per piece (a vessel's track is split where her reports stop for longer than
+  ``max_gap_s`` or jump), with time as the M value of each vertex (seconds since the Unix
+  epoch, UTC) and ``start_utc``/``end_utc``, so that QGIS's Temporal Controller can play
+  them; a piece of one report is no line and is left out. Cut at the antimeridian;
 - ``navigable_water``: the water deep enough for each target draught used, where a chart was
   given.
+
+The file is GeoPackage 1.3, which GDAL reads without a warning from 3.3 on (the 1.4 that
+GDAL 3.12 writes by default makes GDAL 3.6, Debian 12's, warn that it "may only be partially
+supported"); M coordinates are GDAL's since 2.1.
 
 Fields are typed as their values: MMSIs, steps and navigational statuses as integers (empty
 when none), two-valued flags as booleans, measurements as reals, times as UTC date-times;
@@ -26,8 +37,8 @@ from __future__ import annotations
 import dataclasses
 import types
 import typing
-from collections.abc import Sequence
-from enum import Enum
+from collections.abc import Iterator, Sequence
+from enum import Enum, StrEnum
 from pathlib import Path
 from typing import Any
 
@@ -43,6 +54,14 @@ from ..outputs import atomic_path
 from .qgis_styles import add_layer_styles
 
 GEOPACKAGE_NAME = "report.gpkg"
+
+
+class Domains(StrEnum):
+    """Which ship-domain ellipses go into the ``domains`` layer."""
+
+    ALL = "all"
+    RESTRICTED = "restricted"  # those not inside navigable water, where the chart covers them
+    NONE = "none"
 
 
 def _to_wgs84(frame: LocalFrame, geometries: Any) -> np.ndarray:
@@ -118,7 +137,12 @@ def _encounter_table(outcomes: Sequence[EncounterOutcome]) -> pd.DataFrame:
     ]
     hints = typing.get_type_hints(EncounterSummary)
     table = pd.DataFrame.from_records(records, columns=list(hints))
-    return table.astype({name: _dtype(hint) for name, hint in hints.items()})
+    table = table.astype({name: _dtype(hint) for name, hint in hints.items()})
+    # A text column's missing values as None whatever the rows (pandas makes them NaN
+    # beside text, and keeps None in a column of none), so that parts join as the whole.
+    text = [name for name in table.columns if table[name].dtype == object]
+    table[text] = table[text].astype(object).where(table[text].notna(), None)
+    return table
 
 
 def _action_before_cpa_s(summary: EncounterSummary, mmsi: int) -> float:
@@ -137,11 +161,14 @@ def _action_before_cpa_s(summary: EncounterSummary, mmsi: int) -> float:
 Layer = tuple[np.ndarray, pd.DataFrame]
 
 
-def encounter_layers(outcomes: Sequence[EncounterOutcome], frame: LocalFrame) -> dict[str, Layer]:
-    """The layers drawn from the encounters themselves (all but ``navigable_water``), for
-    ``outcomes`` (at least one) in their order; ``frame``: the run's. Layers of consecutive
-    parts of the encounters, joined in order (``join_layers``), are the layers of the whole:
-    every column's type is fixed, whatever values a part holds."""
+def encounter_layers(
+    outcomes: Sequence[EncounterOutcome], frame: LocalFrame, domains: Domains = Domains.RESTRICTED
+) -> dict[str, Layer]:
+    """The layers drawn from the encounters themselves (``encounters``, ``tracks``, ``cpa``
+    and, unless ``domains`` is none, ``domains``), for ``outcomes`` (at least one) in their
+    order; ``frame``: the run's. Layers of consecutive parts of the encounters, joined in
+    order (``join_layers``), are the layers of the whole: every column's type is fixed,
+    whatever values a part holds."""
     points: list[Any] = []
     tracks: list[Any] = []
     cpa: list[Any] = []
@@ -189,11 +216,31 @@ def encounter_layers(outcomes: Sequence[EncounterOutcome], frame: LocalFrame) ->
     point_rows = point_rows.assign(
         action_before_cpa_s=actions, vessel=["own", "target"] * len(outcomes)
     )
-    domains: list[Any] = []
+    layers = {
+        "encounters": (np.asarray(points, dtype=object), point_rows),
+        "tracks": (
+            np.asarray(tracks, dtype=object),
+            pd.DataFrame(track_rows, columns=["encounter_id", "vessel", "mmsi"]),
+        ),
+        "cpa": (np.asarray(cpa, dtype=object), pd.DataFrame(cpa_rows).astype({"tcpa_s": float})),
+    }
+    if domains is not Domains.NONE:
+        layers["domains"] = _domain_layer(outcomes, frame, domains)
+    return layers
+
+
+def _domain_layer(
+    outcomes: Sequence[EncounterOutcome], frame: LocalFrame, domains: Domains
+) -> Layer:
+    """The ellipses of each outcome's assessment (only the restricted ones for
+    ``Domains.RESTRICTED``)."""
+    ellipses: list[Any] = []
     domain_rows: list[pd.DataFrame] = []
     for outcome in outcomes:
         assessment = outcome.assessment
-        domains.extend(assessment.ellipses)
+        restricted = assessment.restricted & assessment.covered
+        kept = restricted if domains is Domains.RESTRICTED else np.ones(len(restricted), bool)
+        ellipses.extend(assessment.ellipses[kept])
         domain_rows.append(
             pd.DataFrame(
                 {
@@ -201,7 +248,7 @@ def encounter_layers(outcomes: Sequence[EncounterOutcome], frame: LocalFrame) ->
                     "target_mmsi": outcome.summary.target_mmsi,
                     "arc": assessment.arc.astype(object),
                     "step": assessment.step,
-                    "restricted": assessment.restricted & assessment.covered,
+                    "restricted": restricted,
                     "covered": assessment.covered,
                     "state": np.where(
                         ~assessment.covered,
@@ -210,17 +257,12 @@ def encounter_layers(outcomes: Sequence[EncounterOutcome], frame: LocalFrame) ->
                     ).astype(object),
                     "verdict": assessment.restriction.value,
                 }
-            )
+            )[kept]
         )
-    return {
-        "encounters": (np.asarray(points, dtype=object), point_rows),
-        "tracks": (
-            np.asarray(tracks, dtype=object),
-            pd.DataFrame(track_rows, columns=["encounter_id", "vessel", "mmsi"]),
-        ),
-        "cpa": (np.asarray(cpa, dtype=object), pd.DataFrame(cpa_rows).astype({"tcpa_s": float})),
-        "domains": (_to_wgs84(frame, domains), pd.concat(domain_rows, ignore_index=True)),
-    }
+    table = pd.concat(domain_rows, ignore_index=True).astype(
+        {"target_mmsi": np.int64, "step": np.int64, "restricted": bool, "covered": bool}
+    )
+    return _to_wgs84(frame, ellipses), table
 
 
 def join_layers(parts: Sequence[dict[str, Layer]]) -> dict[str, Layer]:
@@ -240,13 +282,16 @@ def write_replay_geopackage(
     result: ReplayResult,
     chart: Chart | None,
     parts: Sequence[dict[str, Layer]] | None = None,
+    domains: Domains = Domains.RESTRICTED,
 ) -> None:
     """Write ``report.gpkg`` (see the module docstring) of a result with at least one
     encounter (without, the report has no GeoPackage). ``parts``: ``encounter_layers`` of
-    consecutive parts of ``result.encounters``, made where those are (default: made here)."""
+    consecutive parts of ``result.encounters``, made where those are with the same
+    ``domains`` (default: made here)."""
     outcomes = result.encounters
     frame = result.frame
-    layers = join_layers(parts) if parts else encounter_layers(outcomes, frame)
+    layers = join_layers(parts) if parts else encounter_layers(outcomes, frame, domains)
+    layers["vessel_tracks"] = vessel_track_layer(result.vessel_tracks)
     if chart is not None:
         draughts = sorted({o.summary.target_draught_m for o in outcomes})
         ukc_m = result.params.manoeuvrability.ukc_m
@@ -271,21 +316,97 @@ def write_replay_geopackage(
                 gdal_tz_offsets=fields.tz_offsets,
                 layer=layer,
                 driver="GPKG",
-                geometry_type=_geometry_type(layer),
+                geometry_type=GEOMETRY_TYPES[layer],
                 crs="EPSG:4326",
                 # Tracks and domains cut at the antimeridian are multi-part.
                 promote_to_multi=layer in ("tracks", "domains", "navigable_water"),
                 append=written > 0,
+                **({} if written else {"dataset_options": {"VERSION": "1.3"}}),
             )
             written += 1
         add_layer_styles(tmp, [name for name, (wkb, _) in layers.items() if len(wkb)])
 
 
-def _geometry_type(layer: str) -> str:
-    return {
-        "encounters": "Point",
-        "cpa": "Point",
-        "tracks": "MultiLineString",
-        "domains": "MultiPolygon",
-        "navigable_water": "MultiPolygon",
-    }[layer]
+GEOMETRY_TYPES = {
+    "encounters": "Point",
+    "cpa": "Point",
+    "tracks": "MultiLineString",
+    "domains": "MultiPolygon",
+    "vessel_tracks": "Measured MultiLineString",
+    "navigable_water": "MultiPolygon",
+}
+# Pieces turned into geometries at a time: the text of this many vertices is held at once.
+_CHUNK_VERTICES = 200_000
+
+
+def vessel_track_layer(vertices: pd.DataFrame) -> Layer:
+    """``vessel_tracks`` (module docstring) from ``ReplayResult.vessel_tracks``: a feature
+    per piece of two vertices or more, in the order of the vertices (by MMSI and time)."""
+    mmsi = vertices["mmsi"].to_numpy(dtype=np.int64)
+    piece = vertices["piece"].to_numpy(dtype=np.int64)
+    starts = np.flatnonzero(np.r_[True, (mmsi[1:] != mmsi[:-1]) | (piece[1:] != piece[:-1])])
+    ends = np.r_[starts[1:], len(mmsi)].astype(np.int64)
+    lines = ends - starts >= 2
+    starts, ends = starts[lines], ends[lines]
+    t_s = vertices["t_s"].to_numpy(dtype=float)
+    first = vertices.iloc[starts]
+    reports = vertices["reports"].to_numpy(dtype=np.int64).cumsum()
+    table = pd.DataFrame(
+        {
+            "mmsi": mmsi[starts],
+            "piece": piece[starts],
+            "name": first["name"].astype(object).to_numpy(),
+            "ship_type": first["ship_type"].astype(object).to_numpy(),
+            "length_m": pd.to_numeric(first["length_m"].astype(object)).to_numpy(dtype=float),
+            "start_utc": _utc(t_s[starts]),
+            "end_utc": _utc(t_s[ends - 1]),
+            "reports": reports[ends - 1] - np.r_[0, reports][starts],
+        }
+    )
+    lon = vertices["lon_deg"].to_numpy(dtype=float)
+    lat = vertices["lat_deg"].to_numpy(dtype=float)
+    wkb = [np.zeros(0, dtype=object)]
+    for some_starts, some_ends in _chunks(starts, ends):
+        wkt = [
+            _wkt(lon[a:b], lat[a:b], t_s[a:b]) for a, b in zip(some_starts, some_ends, strict=True)
+        ]
+        wkb.append(np.asarray(shapely.to_wkb(shapely.from_wkt(wkt), flavor="iso"), dtype=object))
+    return np.concatenate(wkb), table
+
+
+def _utc(t_s: np.ndarray) -> pd.Series:
+    """Epoch seconds as UTC times, to the millisecond (the reports' resolution)."""
+    milliseconds = np.round(t_s * 1000.0).astype(np.int64)
+    return pd.Series(pd.to_datetime(milliseconds, unit="ms", utc=True))
+
+
+def _chunks(starts: np.ndarray, ends: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """The pieces ``starts[i]:ends[i]`` in runs of about ``_CHUNK_VERTICES`` vertices."""
+    i = 0
+    while i < len(starts):
+        j = max(i + 1, int(np.searchsorted(ends, starts[i] + _CHUNK_VERTICES, side="right")))
+        yield starts[i:j], ends[i:j]
+        i = j
+
+
+def _wkt(lon: np.ndarray, lat: np.ndarray, t_s: np.ndarray) -> str:
+    """A piece as WKT ``MULTILINESTRING M`` with time as M, in one part, or cut where it
+    crosses the antimeridian (as RFC 7946 asks): the crossing, interpolated, ends one part
+    at ±180° and starts the next at ∓180°. Python's shortest repr of each coordinate reads
+    back as the same float."""
+    coordinates = list(zip(lon.tolist(), lat.tolist(), t_s.tolist(), strict=True))
+    parts = []
+    start = 0
+    for i in np.flatnonzero(np.abs(np.diff(lon)) > 180.0).tolist():
+        (lon_a, lat_a, t_a), (lon_b, lat_b, t_b) = coordinates[i], coordinates[i + 1]
+        edge = 180.0 if lon_a > 0.0 else -180.0
+        fraction = (edge - lon_a) / (lon_b + 2.0 * edge - lon_a)  # lon_b unwrapped
+        lat_c, t_c = lat_a + fraction * (lat_b - lat_a), t_a + fraction * (t_b - t_a)
+        parts.append([*coordinates[start : i + 1], (edge, lat_c, t_c)])
+        coordinates[i] = (-edge, lat_c, t_c)  # the next part's first vertex
+        start = i
+    parts.append(coordinates[start:])
+    lines = ", ".join(
+        "(" + ", ".join(f"{x!r} {y!r} {m!r}" for x, y, m in part) + ")" for part in parts
+    )
+    return f"MULTILINESTRING M ({lines})"
