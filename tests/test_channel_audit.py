@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from colregs9_cli.charts.channel_facts import ChannelRelation
 from colregs9_cli.charts.channels import Channels, make_channel
 from colregs9_cli.charts.s57_classes import ChannelKind
-from colregs9_cli.core.audit import Fact
+from colregs9_cli.core.audit import ConductParams, Fact, conduct
 from colregs9_cli.core.channel_audit import (
     NOT_CHARTED,
     ChannelAuditParams,
@@ -230,3 +230,65 @@ def test_outside_a_scheme_rule_10_does_not_apply() -> None:
     found = _judge(_run(50.0, 0.0, 120))
     assert found.lane.follows_lane is None and found.lane.crosses_at_right_angles is None
     assert found.lane.basis == "in no traffic lane"
+
+
+# -- a turn that follows a bend is not an action ---------------------------------------------
+
+
+def _bend(inner_m: float, outer_m: float, to_deg: float):
+    """An annulus sector round the origin from north clockwise to ``to_deg``."""
+    angles = np.radians(np.linspace(0.0, to_deg, 91))
+    outer = np.column_stack([outer_m * np.sin(angles), outer_m * np.cos(angles)])
+    inner = np.column_stack([inner_m * np.sin(angles), inner_m * np.cos(angles)])[::-1]
+    return shapely.Polygon(np.concatenate([outer, inner]))
+
+
+def _round_the_bend(extra_turn_deg: float) -> pd.DataFrame:
+    """A vessel 30 m to starboard of the axis of a river bend (radius 1 km, turning 90°
+    clockwise), following it from 10° to 70° round at 5 m/s; her course the tangent plus
+    ``extra_turn_deg`` from the row where she is 40° round."""
+    at_deg = np.linspace(10.0, 70.0, 230)
+    radius = 970.0  # the centre of the bend is to starboard: 30 m inside the axis
+    course = at_deg + 90.0 + np.where(at_deg >= 40.0, extra_turn_deg, 0.0)
+    return pd.DataFrame(
+        {
+            "own_north_m": radius * np.cos(np.radians(at_deg)),
+            "own_east_m": radius * np.sin(np.radians(at_deg)),
+            "own_cog_grid_deg": course,
+            "own_heading_grid_deg": course,
+        }
+    )
+
+
+RIVER = Channels(
+    FRAME,
+    tuple(
+        c
+        for c in (
+            make_channel(FRAME, ChannelKind.FAIRWAY, _bend(900.0, 1100.0, 90.0), record_id="R1"),
+        )
+        if c is not None
+    ),
+)
+CONDUCT = ConductParams(
+    course_change_deg=15.0,
+    speed_change_frac=0.25,
+    speed_change_min_kn=1.0,
+    course_judged_above_kn=2.0,
+)
+
+
+@pytest.mark.parametrize(("extra_turn_deg", "action"), [(0.0, "none"), (25.0, "starboard-turn")])
+def test_following_a_bend_is_no_turn_and_a_turn_within_it_is(
+    extra_turn_deg: float, action: str
+) -> None:
+    window = _round_the_bend(extra_turn_deg)
+    found = vessel_in_channel(window, "own_", RIVER, len(window) - 1, True, 1.0, PARAMS)
+    # 60° of bend between the first row and the last, less her own extra turn
+    assert found.bend_deg[-1] == pytest.approx(60.0, abs=4.0)
+    true_course = window["own_cog_grid_deg"].to_numpy()
+    sog_kn = np.full(len(window), 9.7)
+    judged = conduct(true_course - found.bend_deg, sog_kn, CONDUCT)
+    assert judged.action.value == action
+    # Without the channel the bend alone reads as a starboard turn.
+    assert conduct(true_course, sog_kn, CONDUCT).action.value == "starboard-turn"

@@ -8,14 +8,19 @@ import math
 import operator
 import os
 import pickle
+import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
 import pyogrio
 import pytest
+from distributed import Client, LocalCluster
 from typer.testing import CliRunner
 
 from colregs9_cli.cli import app
@@ -125,8 +130,9 @@ def test_a_local_cluster_leaves_nothing_in_the_temporary_directory(tmp_path: Pat
     """``--workers 2`` through the console script, which leaves with ``os._exit``: neither
     multiprocessing's ``pymp-*`` (the forkserver's socket) nor Dask's worker directories
     and lock files stay in TMPDIR (issue 30)."""
-    tmp = tmp_path / "t"
-    tmp.mkdir()
+    # A short TMPDIR of its own: multiprocessing's socket path must fit AF_UNIX's 108 bytes,
+    # which a deep pytest directory (under xdist, say) need not.
+    tmp = Path(tempfile.mkdtemp(prefix="c9-", dir="/tmp"))
     result = subprocess.run(
         [
             *(sys.executable, "-m", "colregs9_cli", "replay", str(NMEA), "--quiet", "--no-plots"),
@@ -137,8 +143,10 @@ def test_a_local_cluster_leaves_nothing_in_the_temporary_directory(tmp_path: Pat
         check=False,
         env={**os.environ, "TMPDIR": str(tmp)},
     )
+    left = sorted(p.name for p in tmp.rglob("*"))
+    shutil.rmtree(tmp)
     assert result.returncode == 0, result.stderr
-    assert sorted(p.name for p in tmp.rglob("*")) == []
+    assert left == []
     assert (tmp_path / "r" / "pairs.csv").is_file()
 
 
@@ -216,3 +224,34 @@ def test_a_worker_reads_its_part_of_a_dataset_itself(tmp_path: Path) -> None:
     pd.testing.assert_frame_equal(merged.statics, alone.statics)
     everything = (-math.inf, math.inf)
     pd.testing.assert_frame_equal(merged.spill.read(*everything), alone.spill.read(*everything))
+
+
+def _worker_settings(dask_worker: Any) -> tuple[bool, float, float, int]:
+    callbacks = dask_worker.periodic_callbacks
+    return (
+        "profile" in callbacks,
+        callbacks["tick"].callback_time,
+        callbacks["memory_monitor"].callback_time,
+        pa.cpu_count(),
+    )
+
+
+def test_workers_started_apart_get_the_local_clusters_settings(tmp_path: Path) -> None:
+    """A cluster started without colregs9 (as ``dask worker`` starts one: Dask's defaults,
+    the profiler sampling every 10 ms, the tick every 20 ms): ``--scheduler`` gives its
+    workers the settings of colregs9's local cluster."""
+    with (
+        LocalCluster(
+            n_workers=1,
+            threads_per_worker=1,
+            dashboard_address=None,
+            scheduler_kwargs={"dashboard_address": ":0"},
+            local_directory=str(tmp_path),
+        ) as cluster,
+        Client(cluster) as plain,
+    ):
+        (before,) = plain.run(_worker_settings).values()
+        assert before[:2] == (True, 20.0)
+        with dask_run.dask_client(1, cluster.scheduler_address) as client:
+            (after,) = client.run(_worker_settings).values()
+    assert after == (False, 1000.0, 1000.0, 1)

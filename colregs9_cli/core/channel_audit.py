@@ -36,7 +36,7 @@ each empty where she is in no lane, with its basis.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -45,7 +45,7 @@ from ..charts.channel_facts import ChannelFacts, ChannelParams, ChannelRelation,
 from ..charts.channels import Channels
 from ..charts.s57_classes import ChannelKind
 from ..errors import ParameterError
-from ..units import wrap_deg
+from ..units import signed_angle_deg, wrap_deg
 from .audit import Fact
 
 
@@ -130,6 +130,10 @@ class VesselInChannel:
     at_least_separation: ChannelPlace
     keeps_to_starboard_side: StarboardSide
     lane: LaneConduct = NO_LANE
+    # From the trigger to the closest approach: how far the axis of the channel she
+    # proceeds along has turned since the trigger (0 where she is not along the one she was
+    # along at the trigger), so that a turn that follows a bend is not an action.
+    bend_deg: np.ndarray = field(default_factory=lambda: np.zeros(0), compare=False)
 
 
 NOT_CHARTED = VesselInChannel(
@@ -247,7 +251,21 @@ def vessel_in_channel(
             facts, channels, slice(0, last + 1), step_s, covers_cpa and cpa_row is not None, params
         ),
         lane=lane_conduct(facts, channels, _heading_grid_deg(rows, prefix), step_s, params),
+        bend_deg=channel_bend_deg(facts),
     )
+
+
+def channel_bend_deg(facts: ChannelFacts) -> np.ndarray:
+    """At each row, how far the local axis (turned to her way) of the channel she proceeds
+    along at the first row has turned since then, while she still proceeds along it; 0
+    elsewhere."""
+    bend = np.zeros(len(facts.channel))
+    if not len(bend) or facts.relation[0] != ChannelRelation.ALONG:
+        return bend
+    along = (facts.relation == ChannelRelation.ALONG) & (facts.channel == facts.channel[0])
+    turned = signed_angle_deg(facts.axis_grid_deg - facts.axis_grid_deg[0])
+    bend[along] = np.nan_to_num(turned[along])
+    return bend
 
 
 def _heading_grid_deg(rows: pd.DataFrame, prefix: str) -> np.ndarray:

@@ -597,7 +597,6 @@ def evaluate_pair(
         hull_offsets(dimensions[1], _static(tracks.vessels, b)),
     )
     lengths_m = (dimensions[0].length_m, dimensions[1].length_m)
-    audit = audit_pair(window, seen, hulls, lengths_m, params.conduct, step_s)
     in_channel = tuple(
         vessel_in_channel(
             window.iloc[: seen.end_row + 1],
@@ -610,6 +609,8 @@ def evaluate_pair(
         )
         for prefix in PREFIXES
     )
+    bends = (in_channel[0].bend_deg, in_channel[1].bend_deg)
+    audit = audit_pair(window, seen, hulls, lengths_m, params.conduct, step_s, bends)
     interaction = _interaction(tracks, oriented, encounter.trigger_step, params.interactions)
     steps = _pair_steps(series, dimensions, claims, chart, params, step_s)
     trigger = series.iloc[0]

@@ -115,7 +115,12 @@ def audit_pair(
     lengths_m: tuple[float, float],
     params: ConductParams,
     step_s: float,
+    bends_deg: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> PairAudit:
+    """The pass audited (module docstring). ``bends_deg``: for each vessel, how far the
+    charted channel she proceeds along has turned since the trigger at each row up to the
+    closest approach (``channel_audit.VesselInChannel.bend_deg``): her course is judged
+    against it, so that following a bend is not a turn."""
     passed = window.iloc[: seen.end_row + 1]
     gaps = (report_gaps(passed, PREFIXES[0]), report_gaps(passed, PREFIXES[1]))
     if seen.cpa_row is None:
@@ -128,7 +133,8 @@ def audit_pair(
             report_gaps=gaps,
         )
     audit = dataclasses.replace(
-        _audit_conduct(window, seen, seen.cpa_row, hulls, params, step_s), report_gaps=gaps
+        _audit_conduct(window, seen, seen.cpa_row, hulls, params, step_s, bends_deg),
+        report_gaps=gaps,
     )
 
     def both(name: str) -> np.ndarray:
@@ -160,6 +166,7 @@ def _audit_conduct(
     hulls: tuple[HullOffsets, HullOffsets],
     params: ConductParams,
     step_s: float,
+    bends_deg: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> PairAudit:
     cpa_utc = window["timestamp"].iloc[cpa_row]
     hull_m = least_hull_separation_m(window.iloc[: seen.end_row + 1], hulls)
@@ -179,11 +186,11 @@ def _audit_conduct(
     until = window.iloc[: cpa_row + 1]
     conducts = tuple(
         conduct(
-            until[f"{prefix}course_deg"].to_numpy(dtype=float),
+            _against_bend(until[f"{prefix}course_deg"].to_numpy(dtype=float), bends_deg, vessel),
             until[f"{prefix}sog_kn"].to_numpy(dtype=float),
             params,
         )
-        for prefix in PREFIXES
+        for vessel, prefix in enumerate(PREFIXES)
     )
     before = tuple(
         None if c.action_row is None else (cpa_row - c.action_row) * step_s for c in conducts
@@ -197,3 +204,15 @@ def _audit_conduct(
         min_hull_separation_m=hull_m,
         hull_antenna_position_assumed=assumed,
     )
+
+
+def _against_bend(
+    course_deg: np.ndarray, bends_deg: tuple[np.ndarray, np.ndarray] | None, vessel: int
+) -> np.ndarray:
+    """Her course less the channel's turn since the trigger, where she follows one."""
+    if bends_deg is None:
+        return course_deg
+    bend = np.zeros(len(course_deg))
+    known = bends_deg[vessel][: len(course_deg)]
+    bend[: len(known)] = np.nan_to_num(known)
+    return course_deg - bend

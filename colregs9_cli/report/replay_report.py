@@ -194,7 +194,7 @@ def format_index(result: ReplayResult, plots: bool) -> str:
         f"({counts.triggered} rows). The {untriggered} encounters that never triggered are "
         "counted in run.json only.",
         f"- `{ENCOUNTER_DIR}/`: each triggered encounter's time series (CSV)"
-        + (" and figure (PNG)." if plots else "."),
+        + (" and figures (PNG: its map, and its range and relative motion)." if plots else "."),
         f"- [{MANIFEST_NAME}]({MANIFEST_NAME}): inputs, parameters, rejects ledger and counts.",
         f"- [{HTML_NAME}]({HTML_NAME}): this report as a web page, with a map and a table "
         "to sort and filter.",
