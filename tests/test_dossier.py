@@ -183,3 +183,36 @@ def test_the_map_marks_whole_minutes_and_the_least_separation(sandiego_replay, t
     )
     assert "at 00:19:12" in line.get_label()
     figure.savefig(io.BytesIO(), format="png", dpi=40)
+
+
+def test_the_dossier_names_the_channel_and_rule_9a(sandiego_replay) -> None:
+    from colregs9_cli.report.dossier import channel_lines
+
+    (champagne,) = [
+        o
+        for o in sandiego_replay.encounters
+        if o.summary.own_name == "CHAMPAGNE" and o.summary.target_name == "LETO"
+    ]
+    own, target = channel_lines(champagne.summary)
+    s = champagne.summary
+    assert own.startswith(
+        f"own ship: at the trigger in San Diego Harbor Channel, along, "
+        f"{s.own_channel_offset_m:.0f} m to starboard of its axis"
+    )
+    assert "rule 9(a), keeps to her starboard side: true" in own
+    assert target.startswith("target: at the trigger in San Diego Harbor Channel, along")
+    outside = [o for o in sandiego_replay.encounters if o.summary.own_name == "SAILEBRATE"]
+    assert all(
+        channel_lines(o.summary) == []
+        for o in outside
+        if o.summary.own_channel is None
+        and o.summary.target_channel is None
+        and o.summary.own_channel_at_min_separation is None
+        and o.summary.target_channel_at_min_separation is None
+    )
+    (rule9,) = [
+        o
+        for o in sandiego_replay.encounters
+        if o.summary.own_name == "SHELTER ISLAND" and o.summary.rule9_applied
+    ]
+    assert channel_lines(rule9.summary)[-1] == "rule 9 decided under clause estimator"

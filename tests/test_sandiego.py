@@ -92,6 +92,8 @@ def test_report_geopackage_opens_with_every_layer(sandiego) -> None:
         "domains",
         "navigable_water",
         "vessel_tracks",
+        "channels",
+        "channel_axes",
     }
     # the QGIS styles, an attribute table beside them
     assert {str(name) for name, kind in pyogrio.list_layers(path) if not kind} == {"layer_styles"}

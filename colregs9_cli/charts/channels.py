@@ -515,7 +515,16 @@ def navigable_widths(
 
 def load_channels(chart: Chart) -> Channels:
     """The channels charted in ``chart``'s files, in its frame, each file's cut to the part
-    of the coverage it decides (module docstring), with the tracks along each area."""
+    of the coverage it decides (module docstring), with the tracks along each area; read
+    once per chart (kept with it)."""
+    if isinstance(chart._channels, Channels):
+        return chart._channels
+    channels = _read_channels(chart)
+    object.__setattr__(chart, "_channels", channels)
+    return channels
+
+
+def _read_channels(chart: Chart) -> Channels:
     items: list[Channel] = []
     several = len(chart.detail_order) > 1
     for rank, path in enumerate(chart.detail_order):

@@ -87,6 +87,9 @@ class Chart:
         default_factory=dict, init=False, repr=False, compare=False
     )
     _coverage_boundary: Any = field(default=None, init=False, repr=False, compare=False)
+    # The charted channels (``channels.load_channels``), read once and carried with the
+    # chart to the workers that draw its figures.
+    _channels: Any = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         shapely.prepare(self.coverage)

@@ -24,6 +24,7 @@ from matplotlib.ticker import FuncFormatter, MaxNLocator
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
 if TYPE_CHECKING:
+    from ..charts.channels import Channels
     from ..charts.water import Chart
     from ..core.manoeuvrability import ManoeuvrabilityAssessment
     from ..geo import LocalFrame
@@ -301,3 +302,46 @@ def _round_length(length_m: float) -> float:
     """1, 2 or 5 times a power of ten, at most ``length_m``."""
     power = 10.0 ** np.floor(np.log10(max(length_m, 1.0)))
     return float(max(m * power for m in (1.0, 2.0, 5.0) if m * power <= max(length_m, 1.0)))
+
+
+CHANNEL_COLOUR = "tab:purple"
+CHANNEL_LABEL = "charted channel"
+CHANNEL_AXIS_LABEL = "channel axis"
+
+
+def draw_channels(
+    ax: Axes, channels: Channels, view: Bounds | None = None, named: Iterable[str] = ()
+) -> None:
+    """The charted channel areas in the view, outlined, and the axes of those ``named`` (the
+    channels the vessels were in), dash-dotted: where rule 9's "narrow channel or fairway"
+    lies, and what "along" and "starboard side" are measured against (``charts.channels``)."""
+    wanted = set(named)
+    areas = [c.geometry for c in channels if c.is_area]
+    axes = [c.axis for c in channels if c.is_area and c.label in wanted]
+    if not areas:
+        return
+    clipped = _in_view(np.asarray(areas, dtype=object), view)
+    patches, _ = _patches(clipped)
+    if patches:
+        ax.add_collection(
+            PatchCollection(
+                patches,
+                facecolor="none",
+                edgecolor=CHANNEL_COLOUR,
+                linewidth=0.8,
+                linestyle="--",
+                zorder=2.2,
+            )
+        )
+        ax.plot([], [], color=CHANNEL_COLOUR, lw=0.8, ls="--", label=CHANNEL_LABEL)
+    shown = False
+    if not axes:
+        return
+    for line in shapely.get_parts(_in_view(np.asarray(axes, dtype=object), view)):
+        if shapely.get_type_id(line) != shapely.GeometryType.LINESTRING or line.is_empty:
+            continue
+        east, north = np.asarray(line.coords)[:, 0], np.asarray(line.coords)[:, 1]
+        ax.plot(east, north, color=CHANNEL_COLOUR, lw=0.7, ls="-.", zorder=2.2)
+        shown = True
+    if shown:
+        ax.plot([], [], color=CHANNEL_COLOUR, lw=0.7, ls="-.", label=CHANNEL_AXIS_LABEL)

@@ -202,6 +202,44 @@ def _gap_text(s: EncounterSummary, who: str) -> str:
     )
 
 
+def _place_text(channel: str | None, relation: str | None, offset_m: float | None) -> str:
+    if channel is None:
+        return "in no charted channel"
+    text = f"in {channel}, {relation}"  # a StrEnum: its value
+    if offset_m is not None:
+        side = "starboard" if offset_m > 0 else "port"
+        text += f", {abs(offset_m):.0f} m to {side} of its axis"
+    return text
+
+
+def channel_lines(s: EncounterSummary) -> list[str]:
+    """Where each vessel was in the charted channels, rule 9(a) for each, and the clause of
+    rule 9 that decided; nothing where no vessel was in a channel and rule 9 did not decide."""
+    lines = []
+    for who, title in (("own", "own ship"), ("target", "target")):
+        at_trigger = _place_text(
+            getattr(s, f"{who}_channel"),
+            getattr(s, f"{who}_channel_relation"),
+            getattr(s, f"{who}_channel_offset_m"),
+        )
+        at_least = _place_text(
+            getattr(s, f"{who}_channel_at_min_separation"),
+            getattr(s, f"{who}_channel_relation_at_min_separation"),
+            getattr(s, f"{who}_channel_offset_m_at_min_separation"),
+        )
+        if at_trigger == at_least == "in no charted channel":
+            continue
+        line = f"{title}: at the trigger {at_trigger}; at the least separation {at_least}"
+        fact = getattr(s, f"{who}_keeps_to_starboard_side")
+        if fact is not None:
+            basis = getattr(s, f"{who}_keeps_to_starboard_side_basis")
+            line += f"; rule 9(a), keeps to her starboard side: {fact.value} ({basis})"
+        lines.append(line)
+    if s.rule9_clause is not None:
+        lines.append(f"rule 9 decided under clause {s.rule9_clause.value}")
+    return lines
+
+
 def report_gap_lines(s: EncounterSummary) -> list[str]:
     """Both vessels' longest report gaps over the passing, in words."""
     return [_gap_text(s, "own"), _gap_text(s, "target")]
@@ -215,7 +253,10 @@ def timeline_html(outcome: EncounterOutcome) -> list[str]:
         f"<h4>Timeline (every {_step_text(step_s)} from the trigger, and at each event)</h4>",
         f"<p>{html.escape(BEARINGS_NOTE)}</p>",
         '<ul class="gaps">',
-        *(f"<li>{html.escape(line)}</li>" for line in report_gap_lines(outcome.summary)),
+        *(
+            f"<li>{html.escape(line)}</li>"
+            for line in channel_lines(outcome.summary) + report_gap_lines(outcome.summary)
+        ),
         "</ul>",
         '<div class="timeline"><table class="timeline"><thead><tr>',
         "".join(f"<th>{html.escape(_HEADERS[c])}</th>" for c in TIMELINE_COLUMNS),
@@ -241,7 +282,10 @@ def timeline_markdown(outcome: EncounterOutcome) -> list[str]:
     lines = [
         f"Timeline, every {_step_text(step_s)} from the trigger and at each event. {BEARINGS_NOTE}",
         "",
-        *(f"- {line}" for line in report_gap_lines(outcome.summary)),
+        *(
+            f"- {line}"
+            for line in channel_lines(outcome.summary) + report_gap_lines(outcome.summary)
+        ),
         "",
         "| " + " | ".join(_HEADERS[c] for c in TIMELINE_COLUMNS) + " |",
         "|" + "|".join(":--" if i < 2 else "--:" for i in range(len(TIMELINE_COLUMNS))) + "|",

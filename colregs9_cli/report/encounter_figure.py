@@ -15,14 +15,18 @@ import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from ..charts.channels import load_channels
 from ..core.replay_results import EncounterOutcome
 from ..timebase import DISPLAY_TIME_FORMAT
 from .chart_plot import (
+    CHANNEL_AXIS_LABEL,
+    CHANNEL_LABEL,
     DEPTH_LABEL,
     NOT_CHARTED_LABEL,
     TRACK_ZORDER,
     Bounds,
     draw_assessment,
+    draw_channels,
     draw_chart,
     geographic_axes,
     show_view,
@@ -317,7 +321,9 @@ def _legend_below(figure: Figure, ax: Any) -> None:
     chart = [
         e
         for e in entries
-        if e[1].endswith("arc") or e[1].startswith("navigable") or e[1] == NOT_CHARTED_LABEL
+        if e[1].endswith("arc")
+        or e[1].startswith("navigable")
+        or e[1] in (NOT_CHARTED_LABEL, CHANNEL_LABEL, CHANNEL_AXIS_LABEL)
     ]
     ellipses = [e for e in entries if " ellipses" in e[1]]
     blank = (Line2D([], [], linestyle="none"), "")
@@ -401,6 +407,12 @@ def encounter_figure(
     if chart is not None:
         depths = draw_chart(ax, chart, s.target_draught_m, ukc_m, view=view)
         figure.colorbar(depths, ax=ax, label=DEPTH_LABEL, shrink=0.6, pad=0.02)
+        named = [
+            getattr(s, f"{who}_{name}")
+            for who in ("own", "target")
+            for name in ("channel", "channel_at_min_separation")
+        ]
+        draw_channels(ax, load_channels(chart), view, [n for n in named if n])
     else:
         show_view(ax, view)
     own_label = _vessel_label(

@@ -33,6 +33,7 @@ UNKNOWN_RGBA = "127,127,127,255"
 WATER_RGBA = "0,200,83,255"
 VESSEL_RGBA = "0,110,120,255"
 PAST_RGBA = "160,160,160,255"
+CHANNEL_RGBA = "148,103,189,255"  # matplotlib's tab:purple, as in the figures
 TRANSPARENT = "0,0,0,0"
 
 # The vertices of a vessel_tracks piece, and the time at the end of the animation frame in
@@ -220,6 +221,16 @@ STYLES: tuple[Style, ...] = (
         "navigable_water",
         "navigable water for the draught, outlined green",
         symbol=Symbol("fill", WATER_RGBA),
+    ),
+    Style(
+        "channels",
+        "charted channels a vessel was in, outlined purple",
+        symbol=Symbol("fill", CHANNEL_RGBA),
+    ),
+    Style(
+        "channel_axes",
+        "their axes, purple dashed",
+        symbol=Symbol("line", CHANNEL_RGBA, dashed=True),
     ),
 )
 

@@ -19,7 +19,10 @@ Layers (each only when it has features):
   epoch, UTC) and ``start_utc``/``end_utc``, so that QGIS's Temporal Controller can play
   them; a piece of one report is no line and is left out. Cut at the antimeridian;
 - ``navigable_water``: the water deep enough for each target draught used, where a chart was
-  given.
+  given;
+- ``channels`` and ``channel_axes``: the charted channel areas a vessel of a triggered pair
+  was in (at the trigger or the least separation), with their names and measures, and their
+  axes (``charts.channels``).
 
 The file is GeoPackage 1.3, which GDAL reads without a warning from 3.3 on (the 1.4 that
 GDAL 3.12 writes by default makes GDAL 3.6, Debian 12's, warn that it "may only be partially
@@ -47,6 +50,7 @@ import pandas as pd
 import pyogrio
 import shapely
 
+from ..charts.channels import Channels, load_channels
 from ..charts.water import Chart
 from ..core.replay_results import EncounterOutcome, EncounterSummary, ReplayResult
 from ..geo import LocalFrame
@@ -300,6 +304,7 @@ def write_replay_geopackage(
             _to_wgs84(frame, water),
             pd.DataFrame({"draught_m": draughts, "ukc_m": ukc_m}),
         )
+        layers.update(channel_layers(load_channels(chart), _channels_used(result), frame))
     with atomic_path(path, suffix=".gpkg") as tmp:
         tmp.unlink()  # GDAL creates the GeoPackage itself
         written = 0
@@ -319,7 +324,8 @@ def write_replay_geopackage(
                 geometry_type=GEOMETRY_TYPES[layer],
                 crs="EPSG:4326",
                 # Tracks and domains cut at the antimeridian are multi-part.
-                promote_to_multi=layer in ("tracks", "domains", "navigable_water"),
+                promote_to_multi=layer
+                in ("tracks", "domains", "navigable_water", "channels", "channel_axes"),
                 append=written > 0,
                 **({} if written else {"dataset_options": {"VERSION": "1.3"}}),
             )
@@ -334,7 +340,47 @@ GEOMETRY_TYPES = {
     "domains": "MultiPolygon",
     "vessel_tracks": "Measured MultiLineString",
     "navigable_water": "MultiPolygon",
+    "channels": "MultiPolygon",
+    "channel_axes": "MultiLineString",
 }
+
+
+def _channels_used(result: ReplayResult) -> set[str]:
+    """The charted channels a vessel of a triggered pair was in, at the trigger or at the
+    least separation."""
+    return {
+        name
+        for pair in result.pairs
+        for field in ("channel", "channel_at_min_separation")
+        for vessel in ("a", "b")
+        if (name := getattr(pair.summary, f"{field}_{vessel}"))
+    }
+
+
+def channel_layers(channels: Channels, used: set[str], frame: LocalFrame) -> dict[str, Layer]:
+    """The channel areas in ``used`` (by label), with what names and measures them, and
+    their axes."""
+    items = [c for c in channels if c.is_area and c.label in used]
+    table = pd.DataFrame(
+        {
+            "label": [c.label for c in items],
+            "kind": [c.kind.value for c in items],
+            "record_id": [c.record_id for c in items],
+            "name": [c.name for c in items],
+            "orient_deg": [c.orient_deg for c in items],
+            "axis_source": [c.axis_source.value for c in items],
+            "axis_deg": [c.axis_deg for c in items],
+            "depth_m": [c.depth_m for c in items],
+            "width_m": [c.width_m for c in items],
+            "length_m": [c.length_m for c in items],
+        }
+    ).astype({"orient_deg": float, "axis_deg": float, "depth_m": float, "width_m": float})
+    return {
+        "channels": (_to_wgs84(frame, [c.geometry for c in items]), table),
+        "channel_axes": (_to_wgs84(frame, [c.axis for c in items]), table[["label", "kind"]]),
+    }
+
+
 # Pieces turned into geometries at a time: the text of this many vertices is held at once.
 _CHUNK_VERTICES = 200_000
 
