@@ -292,3 +292,61 @@ def test_following_a_bend_is_no_turn_and_a_turn_within_it_is(
     assert judged.action.value == action
     # Without the channel the bend alone reads as a starboard turn.
     assert conduct(true_course, sog_kn, CONDUCT).action.value == "starboard-turn"
+
+
+# -- two vessels meeting along a channel ---------------------------------------------------
+
+
+def _place(channel: str | None, relation: ChannelRelation):
+    from colregs9_cli.core.channel_audit import ChannelPlace, StarboardSide, VesselInChannel
+
+    here = ChannelPlace(channel, relation, 20.0)
+    return VesselInChannel(here, here, StarboardSide(None, ""))
+
+
+@pytest.mark.parametrize(
+    ("places", "courses", "meeting"),
+    [
+        # along the same river in a bend: courses 120° apart, as the bend makes them
+        (("River", "River"), (30.0, 270.0), True),
+        (("River", "River"), (30.0, 50.0), False),  # the same way: an overtaking
+        (("River", "Other"), (30.0, 210.0), False),
+        ((None, "River"), (30.0, 210.0), False),
+    ],
+)
+def test_meeting_along_a_channel(places, courses, meeting) -> None:
+    from colregs9_cli.core.channel_audit import meeting_along_a_channel
+
+    vessels = tuple(
+        _place(name, ChannelRelation.ALONG if name else ChannelRelation.OUTSIDE) for name in places
+    )
+    assert meeting_along_a_channel(vessels, courses) is meeting
+
+
+def test_a_crossing_read_in_a_bend_is_held_as_head_on() -> None:
+    from colregs9_cli.core.colregs import (
+        ColregsEvaluation,
+        Role,
+        Situation,
+        SituationBasis,
+    )
+    from colregs9_cli.core.pair import _held
+
+    def crossing(rows: int) -> ColregsEvaluation:
+        return ColregsEvaluation(
+            situation=np.array([Situation.CROSSING] * rows, dtype=object),
+            own_role=np.array([Role.GIVE_WAY] * rows, dtype=object),
+            target_role=np.array([Role.STAND_ON] * rows, dtype=object),
+            own_overtaking=np.zeros(rows, dtype=bool),
+            ambiguous=np.zeros(rows, dtype=bool),
+            basis=np.array([SituationBasis.SECTORS] * rows, dtype=object),
+            beta_deg=np.full(rows, 30.0),
+            beta_prime_deg=np.full(rows, 330.0),
+            closing=np.ones(rows, dtype=bool),
+        )
+
+    held = _held(crossing(3), meeting_in_channel=True)
+    assert list(held.situation) == [Situation.HEAD_ON] * 3
+    assert list(held.own_role) == list(held.target_role) == [Role.GIVE_WAY] * 3
+    assert list(held.basis) == [SituationBasis.CHANNEL] * 3
+    assert list(_held(crossing(3)).situation) == [Situation.CROSSING] * 3

@@ -271,3 +271,17 @@ def channel_bend_deg(facts: ChannelFacts) -> np.ndarray:
 def _heading_grid_deg(rows: pd.DataFrame, prefix: str) -> np.ndarray:
     heading = rows[f"{prefix}heading_grid_deg"].to_numpy(dtype=float)
     return np.where(np.isfinite(heading), heading, rows[f"{prefix}cog_grid_deg"].to_numpy(float))
+
+
+def meeting_along_a_channel(
+    vessels: tuple[VesselInChannel, VesselInChannel], courses_deg: tuple[float, float]
+) -> bool:
+    """Whether the two vessels proceed along the same charted channel in opposite
+    directions at the trigger (courses over ground more than 90° apart, each within the
+    along tolerance of the axis): they meet, whatever the channel's bends make of their
+    bearings, and a crossing is read as head-on (rule 14; rule 9(a) keeps each to her
+    starboard side)."""
+    a, b = (v.at_trigger for v in vessels)
+    along = a.relation is ChannelRelation.ALONG and b.relation is ChannelRelation.ALONG
+    apart_deg = abs(float(signed_angle_deg(courses_deg[0] - courses_deg[1])))
+    return along and a.channel is not None and a.channel == b.channel and apart_deg > 90.0

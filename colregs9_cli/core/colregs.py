@@ -67,6 +67,7 @@ class SituationBasis(StrEnum):
     SECTORS = "sectors"
     HEAD_ON_IN_DOUBT = "head-on in doubt"  # rule 14(c)
     SAME_SIDE = "same-side crossing"  # rule 15 names both or neither; see the module docstring
+    CHANNEL = "meeting along a charted channel"  # core/channel_audit.py: a bend is no crossing
     NONE = "none"
 
 

@@ -48,8 +48,22 @@ from .audit import (
     all_of,
     stand_on_turned_to_port_for_vessel_on_port,
 )
-from .channel_audit import NOT_CHARTED, ChannelAuditParams, VesselInChannel, vessel_in_channel
-from .colregs import ColregsEvaluation, ColregsParams, Kinematics, Role, evaluate_colregs
+from .channel_audit import (
+    NOT_CHARTED,
+    ChannelAuditParams,
+    VesselInChannel,
+    meeting_along_a_channel,
+    vessel_in_channel,
+)
+from .colregs import (
+    ColregsEvaluation,
+    ColregsParams,
+    Kinematics,
+    Role,
+    Situation,
+    SituationBasis,
+    evaluate_colregs,
+)
 from .encounters import Encounter, EncounterParams, encounter_series
 from .interactions import (
     Interaction,
@@ -449,11 +463,13 @@ def _state(series: pd.DataFrame, prefix: str) -> dict[str, np.ndarray]:
     }
 
 
-def _held(g_a: ColregsEvaluation) -> ColregsEvaluation:
+def _held(g_a: ColregsEvaluation, meeting_in_channel: bool = False) -> ColregsEvaluation:
     """The trigger's situation and roles held at every step (rule 13(d)); the bearings and
-    closing flags stay those of each step."""
+    closing flags stay those of each step. Two vessels meeting along a charted channel
+    (``channel_audit.meeting_along_a_channel``) that G_a reads as crossing, as a bend makes
+    their courses cross, are head-on."""
     rows = len(g_a.situation)
-    return ColregsEvaluation(
+    held = ColregsEvaluation(
         **{
             name: np.repeat(getattr(g_a, name)[:1], rows)
             for name in ("situation", "own_role", "target_role", "own_overtaking", "ambiguous")
@@ -462,6 +478,16 @@ def _held(g_a: ColregsEvaluation) -> ColregsEvaluation:
         beta_deg=g_a.beta_deg,
         beta_prime_deg=g_a.beta_prime_deg,
         closing=g_a.closing,
+    )
+    if not (meeting_in_channel and g_a.situation[0] is Situation.CROSSING):
+        return held
+    return dataclasses.replace(
+        held,
+        situation=np.repeat(np.array([Situation.HEAD_ON], dtype=object), rows),
+        own_role=np.repeat(np.array([Role.GIVE_WAY], dtype=object), rows),
+        target_role=np.repeat(np.array([Role.GIVE_WAY], dtype=object), rows),
+        ambiguous=np.zeros(rows, dtype=bool),
+        basis=np.repeat(np.array([SituationBasis.CHANNEL], dtype=object), rows),
     )
 
 
@@ -472,6 +498,7 @@ def _pair_steps(
     chart: Chart | None,
     params: PairParams,
     step_s: float,
+    meeting_in_channel: bool = False,
 ) -> PairSteps:
     """G_a, the estimates and G_d of both seats at every step of ``series`` (a = own_)."""
     g_a = evaluate_colregs(
@@ -479,7 +506,7 @@ def _pair_steps(
         params.colregs,
         course_judged_above_kn=params.conduct.course_judged_above_kn,
     )
-    held = _held(g_a)
+    held = _held(g_a, meeting_in_channel)
     situation = held.situation[0]
     roles = (held.own_role[0], held.target_role[0])
     statuses = params.rule9.restricted_nav_statuses
@@ -612,7 +639,11 @@ def evaluate_pair(
     bends = (in_channel[0].bend_deg, in_channel[1].bend_deg)
     audit = audit_pair(window, seen, hulls, lengths_m, params.conduct, step_s, bends)
     interaction = _interaction(tracks, oriented, encounter.trigger_step, params.interactions)
-    steps = _pair_steps(series, dimensions, claims, chart, params, step_s)
+    meeting = meeting_along_a_channel(
+        (in_channel[0], in_channel[1]),
+        (float(series["own_cog_deg"].iloc[0]), float(series["target_cog_deg"].iloc[0])),
+    )
+    steps = _pair_steps(series, dimensions, claims, chart, params, step_s, meeting)
     trigger = series.iloc[0]
     vessels = tuple(
         _vessel_at_trigger(tracks, mmsi, prefix, trigger, dimensions[i], claims[i], steps, audit, i)
