@@ -81,4 +81,5 @@ def swapped(verdict: PairVerdict) -> PairVerdict:
         role_final=(verdict.role_final[1], verdict.role_final[0]),
         deciding_rule=verdict.deciding_rule,
         both_restricted=verdict.both_restricted,
+        rule9_clause=verdict.rule9_clause,
     )

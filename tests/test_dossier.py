@@ -210,9 +210,12 @@ def test_the_dossier_names_the_channel_and_rule_9a(sandiego_replay) -> None:
         and o.summary.own_channel_at_min_separation is None
         and o.summary.target_channel_at_min_separation is None
     )
-    (rule9,) = [
+    (declined,) = [
         o
         for o in sandiego_replay.encounters
-        if o.summary.own_name == "SHELTER ISLAND" and o.summary.rule9_applied
+        if o.summary.own_name == "SHELTER ISLAND" and o.summary.rule9_clause is not None
     ]
-    assert channel_lines(rule9.summary)[-1] == "rule 9 decided under clause estimator"
+    assert channel_lines(declined.summary)[-1] == (
+        "rule 9 not applied though the estimator found a vessel restricted: she is in no "
+        "charted channel"
+    )

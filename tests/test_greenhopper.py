@@ -363,8 +363,11 @@ def test_alpha_one_still_restricted_and_no_longer_clear(demo: DemoRun, tmp_path:
     r(1 − cos θ) = 469.2 m to either side (273.8 m at α = 0.4) and only r·sin θ = 220.6 m
     ahead (563.3 m). Sideways is where the shores are: the restricted target stays restricted
     (her starboard arc runs onto the Nørresundby shallows sooner) and the clear target's port
-    arc now reaches the shallows off Aalborg, so she becomes restricted too and rule 9 makes
-    the Greenhopper give way in both scenarios.
+    arc now reaches the shallows off Aalborg, so she becomes restricted too. Rule 9 makes the
+    Greenhopper give way to the restricted target, which proceeds along the modelled chart's
+    dredged channel (9(b)); the clear scenario's target sails outside it, so with the
+    chart's channels known rule 9 binds no one there and rule 15 stands (clause
+    ``estimator``): the estimator alone, as in the paper, would have inverted it.
     """
     verdicts = {}
     for name in NAMES:
@@ -385,7 +388,11 @@ def test_alpha_one_still_restricted_and_no_longer_clear(demo: DemoRun, tmp_path:
     assert set(restricted.assessment.arc[red]) == {"cw"}  # the starboard arc, towards Nørresundby
     assert clear.summary.target_estimated_restricted is Restriction.RESTRICTED
     assert clear.summary.automaton_path == "D1>D2>D3>D4"
-    assert clear.summary.own_role_final.value == "give-way"
+    assert clear.summary.target_channel is None
+    assert clear.summary.rule9_clause.value == "estimator" and not clear.summary.rule9_applied
+    assert clear.summary.own_role_final.value == "stand-on"
+    assert restricted.summary.rule9_clause.value == "9(b)"
+    assert restricted.summary.own_role_final.value == "give-way"
     red = clear.assessment.restricted
     assert set(clear.assessment.arc[red]) == {"ccw"}  # the port arc, towards Aalborg
 

@@ -355,10 +355,83 @@ def test_the_clause_of_rule_9_that_binds_the_other_vessel(restricted, other, cla
     assert rule9_clause(_standing(**restricted), _standing(**other)).value == clause
 
 
-def test_sandiego_names_the_clause_where_rule_9_decided(sandiego_replay) -> None:
-    # SHELTER ISLAND, a 9 m yacht the estimator finds restricted outside any charted
-    # channel; WHITE NIGHTS, proceeding along the main channel, gives way to her.
+def test_sandiego_rule_9_binds_no_one_outside_a_charted_channel(sandiego_replay) -> None:
+    # SHELTER ISLAND, a 9 m yacht the estimator finds restricted by shoals outside any
+    # charted channel, meets WHITE NIGHTS proceeding along the main channel: rule 9 is about
+    # narrow channels, so with the chart's channels known it does not invert rule 15, under
+    # which SHELTER ISLAND, with WHITE NIGHTS on her starboard side, gives way.
     summaries = [p.summary for p in sandiego_replay.pairs]
-    applied = [s for s in summaries if s.rule9_applied]
-    assert [(s.name_a, s.rule9_clause.value) for s in applied] == [("SHELTER ISLAND", "estimator")]
-    assert all(s.rule9_clause is None for s in summaries if not s.rule9_applied)
+    assert not any(s.rule9_applied for s in summaries)
+    (s,) = [s for s in summaries if s.rule9_clause is not None]
+    assert (s.name_a, s.name_b) == ("SHELTER ISLAND", "WHITE NIGHTS")
+    assert s.rule9_clause.value == "estimator" and s.deciding_rule.value == "15"
+    assert s.estimated_restricted_a.value == "true" and s.channel_a is None
+    assert s.channel_relation_b.value == "along"
+    assert (s.role_final_a.value, s.role_final_b.value) == ("give-way", "stand-on")
+
+
+@pytest.mark.parametrize(
+    ("other", "inverted", "clause"),
+    [
+        ({"small_or_sailing": True}, True, "9(b)"),
+        ({"crossing_channel": True}, True, "9(d)"),
+        ({"along_channel": True}, False, "none"),
+    ],
+)
+def test_with_the_channels_known_rule_9_inverts_only_where_a_clause_binds(
+    other, inverted, clause
+) -> None:
+    # A crossing: vessel a gives way under rule 15; b, along a channel, is found restricted.
+    roles = (Role.GIVE_WAY, Role.STAND_ON)
+    flipped = (Role.STAND_ON, Role.GIVE_WAY)
+    # a stands on under rule 15 here, b would give way; b's estimate says restricted
+    verdict = decide_pair(
+        Situation.CROSSING,
+        flipped,
+        (None, None),
+        ("false", "true"),
+        channels=(_standing(**other), _standing(along_channel=True)),
+    )
+    assert verdict.rule9_clause.value == clause
+    assert verdict.rule9_applied is inverted
+    assert verdict.role_final == (roles if inverted else flipped)
+    # Without channels charted: the paper's estimator alone inverts.
+    paper = decide_pair(Situation.CROSSING, flipped, (None, None), ("false", "true"))
+    assert paper.rule9_applied and paper.rule9_clause.value == "estimator"
+
+
+_STANDINGS = st.builds(
+    lambda *flags: _standing(**dict(zip(_NAMES, flags, strict=True))),
+    *(st.booleans() for _ in range(4)),
+)
+_NAMES = ("along_channel", "crossing_channel", "small_or_sailing", "fishing")
+
+
+@given(
+    st.sampled_from([HO, CR, OT, NS]),
+    st.booleans(),
+    st.sampled_from([None, 0, 3, 4, 7, 8]),
+    st.sampled_from([None, 0, 3, 4, 7, 8]),
+    st.sampled_from(["true", "false", "unknown"]),
+    st.sampled_from(["true", "false", "unknown"]),
+    _STANDINGS,
+    _STANDINGS,
+)
+def test_with_channels_the_verdict_is_the_same_from_both_seats(
+    situation, flip, nav_a, nav_b, est_a, est_b, standing_a, standing_b
+) -> None:
+    roles = ROLE_PAIRS[situation] if not flip else ROLE_PAIRS[situation][::-1]
+    verdict = decide_pair(
+        situation, roles, (nav_a, nav_b), (est_a, est_b), channels=(standing_a, standing_b)
+    )
+    mirrored = decide_pair(
+        situation,
+        roles[::-1],
+        (nav_b, nav_a),
+        (est_b, est_a),
+        channels=(standing_b, standing_a),
+    )
+    assert mirrored == swapped(verdict)
+    # rule 9 decides only where a clause binds the other vessel
+    if verdict.rule9_applied:
+        assert verdict.rule9_clause.value in ("9(b)", "9(c)", "9(d)")

@@ -94,7 +94,6 @@ from .rule9 import (
     Rule9Clause,
     Rule9Params,
     decide_pair,
-    rule9_clause,
 )
 from .rule9 import nav_status_finding as _finding
 from .tracks import Tracks
@@ -137,7 +136,6 @@ class VesselAtTrigger:
     estimated_restricted: Restriction
     conduct: Conduct
     action_before_cpa_s: float | None
-    ship_type: str | None = None
 
     @property
     def nav_status_used(self) -> int | None:
@@ -175,32 +173,16 @@ class PairEvaluation:
     restricted_nav_statuses: frozenset[int]
     interaction: Interaction
     swing_model: SwingModel
-    # Each vessel and the charted channels (channel_audit.py), vessel order.
+    # Each vessel and the charted channels (channel_audit.py), vessel order, and what rule 9's
+    # clauses read of them (None: the chart charts no channel).
     in_channel: tuple[VesselInChannel, VesselInChannel] = (NOT_CHARTED, NOT_CHARTED)
+    standings: tuple[ChannelStanding, ChannelStanding] | None = None
 
     @property
     def rule9_clause(self) -> Rule9Clause | None:
-        """Where rule 9 decided: the clause under which the other vessel keeps out of the way
-        of the one it made stand on (``rule9.rule9_clause``); None where it did not."""
-        verdict = self.verdict
-        if not verdict.rule9_applied:
-            return None
-        restricted = verdict.role_final.index(Role.STAND_ON)
-        return rule9_clause(self._standing(restricted), self._standing(1 - restricted))
-
-    def _standing(self, index: int) -> ChannelStanding:
-        vessel, place = self.vessels[index], self.in_channel[index]
-        status = vessel.nav_status_used
-        length_known = "length_m" not in vessel.dimensions.defaulted
-        relations = (place.at_trigger.relation, place.at_least_separation.relation)
-        return ChannelStanding(
-            along_channel=place.at_trigger.relation is ChannelRelation.ALONG,
-            crossing_channel=ChannelRelation.CROSSING in relations,
-            small_or_sailing=(length_known and vessel.dimensions.length_m < RULE_9B_LENGTH_M)
-            or vessel.ship_type == "Sailing"
-            or status == NavStatus.UNDER_WAY_SAILING,
-            fishing=vessel.ship_type == "Fishing" or status == NavStatus.ENGAGED_IN_FISHING,
-        )
+        """Where the estimator found the vessel that rule 9 would make stand on restricted:
+        the clause that binds the other (``rule9.decide_pair``); None where it did not."""
+        return self.verdict.rule9_clause
 
     @property
     def is_encounter(self) -> bool:
@@ -231,6 +213,7 @@ class PairEvaluation:
             (a.estimated_restricted, b.estimated_restricted),
             (a.nav_status_used, b.nav_status_used),
             self.restricted_nav_statuses,
+            self.standings,
         )
 
     @property
@@ -499,6 +482,7 @@ def _pair_steps(
     params: PairParams,
     step_s: float,
     meeting_in_channel: bool = False,
+    standings: tuple[ChannelStanding, ChannelStanding] | None = None,
 ) -> PairSteps:
     """G_a, the estimates and G_d of both seats at every step of ``series`` (a = own_)."""
     g_a = evaluate_colregs(
@@ -536,7 +520,9 @@ def _pair_steps(
             assessed_row[vessel].append(estimators[vessel].assessed_row)
         key = (nav[0][row], nav[1][row], estimates[0][row], estimates[1][row])
         if key not in cache:
-            cache[key] = decide_pair(situation, roles, (key[0], key[1]), (key[2], key[3]), statuses)
+            cache[key] = decide_pair(
+                situation, roles, (key[0], key[1]), (key[2], key[3]), statuses, standings
+            )
         verdicts.append(cache[key])
     return PairSteps(
         series=series,
@@ -555,6 +541,7 @@ def rests_on_defaults(
     estimates: tuple[Restriction, Restriction],
     nav_status: tuple[int | None, int | None],
     restricted_nav_statuses: frozenset[int],
+    standings: tuple[ChannelStanding, ChannelStanding] | None = None,
 ) -> bool:
     """True when an estimate made from defaulted dimensions decided the verdict: the other
     answer about that vessel would give other final roles or another deciding rule. This
@@ -576,6 +563,7 @@ def rests_on_defaults(
             nav_status,
             (changed[0], changed[1]),
             restricted_nav_statuses,
+            standings,
         )
         if (alternative.role_final, alternative.deciding_rule) != (
             verdict.role_final,
@@ -643,7 +631,30 @@ def evaluate_pair(
         (in_channel[0], in_channel[1]),
         (float(series["own_cog_deg"].iloc[0]), float(series["target_cog_deg"].iloc[0])),
     )
-    steps = _pair_steps(series, dimensions, claims, chart, params, step_s, meeting)
+    standings = (
+        None
+        if channels is None or not any(c.is_area for c in channels)
+        else tuple(
+            channel_standing(
+                in_channel[i],
+                dimensions[i],
+                text_or_none(_static(tracks.vessels, mmsi).get("ship_type")),
+                claims[i].belief(nav_status(series[f"{prefix}nav_status"].iloc[0])),
+                nav_status(series[f"{prefix}nav_status"].iloc[0]),
+            )
+            for i, (mmsi, prefix) in enumerate(zip((a, b), PREFIXES, strict=True))
+        )
+    )
+    steps = _pair_steps(
+        series,
+        dimensions,
+        claims,
+        chart,
+        params,
+        step_s,
+        meeting,
+        None if standings is None else (standings[0], standings[1]),
+    )
     trigger = series.iloc[0]
     vessels = tuple(
         _vessel_at_trigger(tracks, mmsi, prefix, trigger, dimensions[i], claims[i], steps, audit, i)
@@ -659,6 +670,7 @@ def evaluate_pair(
         interaction=interaction,
         swing_model=params.manoeuvrability.swing_model,
         in_channel=(in_channel[0], in_channel[1]),
+        standings=None if standings is None else (standings[0], standings[1]),
     )
 
 
@@ -682,6 +694,29 @@ def _interaction(
     )
     return classify_interaction(
         around, trigger_row, (facts[0], facts[1]), params, tracks.step_s, approach_s
+    )
+
+
+def channel_standing(
+    place: VesselInChannel,
+    dimensions: VesselDimensions,
+    ship_type: str | None,
+    belief: NavStatusBelief,
+    status: int | None,
+) -> ChannelStanding:
+    """What rule 9's clauses read of a vessel: along or crossing a charted channel (at the
+    trigger, or crossing at the least separation), under 20 m (a reported length) or
+    sailing, fishing (her AIS type, or a navigational status that is believed)."""
+    used = status if belief.believed else None
+    length_known = "length_m" not in dimensions.defaulted
+    relations = (place.at_trigger.relation, place.at_least_separation.relation)
+    return ChannelStanding(
+        along_channel=place.at_trigger.relation is ChannelRelation.ALONG,
+        crossing_channel=ChannelRelation.CROSSING in relations,
+        small_or_sailing=(length_known and dimensions.length_m < RULE_9B_LENGTH_M)
+        or ship_type == "Sailing"
+        or used == NavStatus.UNDER_WAY_SAILING,
+        fishing=ship_type == "Fishing" or used == NavStatus.ENGAGED_IN_FISHING,
     )
 
 
@@ -720,5 +755,4 @@ def _vessel_at_trigger(
         estimated_restricted=steps.estimates[index][0],
         conduct=audit.conducts[index],
         action_before_cpa_s=audit.before_cpa_s[index],
-        ship_type=text_or_none(_static(tracks.vessels, mmsi).get("ship_type")),
     )

@@ -273,6 +273,9 @@ class PairVerdict:
     role_final: tuple[Role, Role]
     deciding_rule: DecidingRule
     both_restricted: bool
+    # Where the estimator found the vessel that rule 9 would make stand on restricted: the
+    # clause that binds the other (``rule9_clause``); None where it did not arise.
+    rule9_clause: Rule9Clause | None = None
 
     @property
     def rule9_applied(self) -> bool:
@@ -292,11 +295,15 @@ def decide_pair(
     nav_status: tuple[int | None, int | None],
     estimated_restricted: tuple[str, str],
     restricted_nav_statuses: frozenset[int] = frozenset({3, 4}),
+    channels: tuple[ChannelStanding, ChannelStanding] | None = None,
 ) -> PairVerdict:
     """The final roles of vessels a and b (module docstring), from both seats' G_d.
 
     Each tuple holds vessel a's value, then vessel b's. ``estimated_restricted`` is each
-    vessel's estimator verdict (a ``Restriction`` or its string).
+    vessel's estimator verdict (a ``Restriction`` or its string). ``channels``: where the
+    chart charts channels, each vessel's standing in them; rule 9 then decides only where
+    a clause binds the other vessel (``rule9_clause``: 9(b), (c) or (d)); without, the
+    estimator alone decides, as in the paper.
     """
     role_a, role_b = role_colregs
     seat_a = assess_rule9(role_b, nav_status[1], estimated_restricted[1], restricted_nav_statuses)
@@ -314,19 +321,25 @@ def decide_pair(
     )
     final = role_colregs
     rule = _STEERING_RULE[situation]
+    clause: Rule9Clause | None = None
     if situation not in (Situation.NONE, Situation.OVERTAKING):
         if restricted[0] != restricted[1]:
             about_restricted = seat_b if restricted[0] else seat_a
             by_restriction = (
                 (Role.STAND_ON, Role.GIVE_WAY) if restricted[0] else (Role.GIVE_WAY, Role.STAND_ON)
             )
-            if by_restriction != final:
-                final = by_restriction
-                rule = (
-                    DecidingRule.RULE_9
-                    if about_restricted.d3 is Finding.TRUE
-                    else DecidingRule.RULE_18
+            by_estimator = about_restricted.d3 is Finding.TRUE
+            if by_restriction != final and by_estimator:
+                which = 0 if restricted[0] else 1
+                clause = (
+                    Rule9Clause.ESTIMATOR
+                    if channels is None
+                    else rule9_clause(channels[which], channels[1 - which])
                 )
+            binds = channels is None or clause not in (Rule9Clause.ESTIMATOR, Rule9Clause.NO_CLAUSE)
+            if by_restriction != final and (binds or not by_estimator):
+                final = by_restriction
+                rule = DecidingRule.RULE_9 if by_estimator else DecidingRule.RULE_18
         elif not restricted[0]:
             rank_a, rank_b = rule18_rank(nav_status[0]), rule18_rank(nav_status[1])
             by_rank = (
@@ -344,6 +357,7 @@ def decide_pair(
         role_final=final,
         deciding_rule=rule,
         both_restricted=situation is not Situation.NONE and all(restricted),
+        rule9_clause=clause,
     )
 
 

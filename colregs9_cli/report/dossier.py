@@ -235,8 +235,15 @@ def channel_lines(s: EncounterSummary) -> list[str]:
             basis = getattr(s, f"{who}_keeps_to_starboard_side_basis")
             line += f"; rule 9(a), keeps to her starboard side: {fact.value} ({basis})"
         lines.append(line)
-    if s.rule9_clause is not None:
+    if s.rule9_clause is not None and s.rule9_applied:
         lines.append(f"rule 9 decided under clause {s.rule9_clause.value}")
+    elif s.rule9_clause is not None:
+        why = (
+            "she is in no charted channel"
+            if s.rule9_clause.value == "estimator"
+            else "no clause of rule 9(b)-(d) binds the other vessel"
+        )
+        lines.append(f"rule 9 not applied though the estimator found a vessel restricted: {why}")
     return lines
 
 
