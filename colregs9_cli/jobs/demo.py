@@ -7,8 +7,8 @@ the own-ship seat, and reports the verdict of her triggered encounter. Every fil
 one output directory:
 
 - ``simulate-<scenario>.csv``: the synthetic AIS;
-- ``<scenario>/``: the replay's reports (encounters.csv, encounters/<id>.csv and .png,
-  index.md, run.json);
+- ``<scenario>/``: the replay's reports (index.html, pairs.csv, encounters.csv,
+  encounters/<id>.csv and the figures, report.gpkg, index.md, run.json);
 - ``<scenario>.png``: a copy of the encounter's figure, the paper's Figure "restricted" or
   "not restricted";
 - ``run.json``: the inputs and both verdicts.
@@ -152,8 +152,8 @@ def format_demo(result: DemoResult) -> str:
             f"  {verdict.scenario}",
             f"    figure   {verdict.figure}",
             f"    AIS      {verdict.simulation.out_path}",
-            f"    reports  {verdict.replay.out_dir}/ (pairs.csv, encounters.csv, report.gpkg, "
-            "index.md, run.json)",
+            f"    reports  {verdict.replay.out_dir}/ (index.html, pairs.csv, encounters.csv, "
+            "report.gpkg, index.md, run.json)",
         ]
     return "\n".join(lines) + "\n"
 
