@@ -177,7 +177,10 @@ def dask_client(
                 # The scheduler's HTTP server starts even without a dashboard, on 8787 unless
                 # told otherwise, and warns on stderr when another cluster holds that port.
                 scheduler_kwargs={"dashboard_address": ":0"},
-                silence_logs=logging.ERROR,
+                # Dask's own log lines are not the tool's: a worker that misses a heartbeat
+                # while the cluster closes logs an ERROR with a traceback. A task's failure
+                # reaches the run as an exception, said in one line.
+                silence_logs=logging.CRITICAL,
                 local_directory=str(local_dir),
                 # What the workers' own temporary files would leave, in the same place.
                 env={"TMPDIR": str(local_dir)},
