@@ -599,18 +599,16 @@ def evaluate_pair(
     # G_a and G_d run until the pair is past: until the range has opened clearly past its
     # least value (core/passing.py), or the data ends.
     series = window.iloc[: seen.end_row + 1]
+    statics = (_static(tracks.vessels, a), _static(tracks.vessels, b))
     dimensions = (
-        vessel_dimensions(_static(tracks.vessels, a), params.dimensions),
-        vessel_dimensions(_static(tracks.vessels, b), params.dimensions),
+        vessel_dimensions(statics[0], params.dimensions),
+        vessel_dimensions(statics[1], params.dimensions),
     )
     claims = (
-        _Claims.of(_static(tracks.vessels, a), dimensions[0], params.claims),
-        _Claims.of(_static(tracks.vessels, b), dimensions[1], params.claims),
+        _Claims.of(statics[0], dimensions[0], params.claims),
+        _Claims.of(statics[1], dimensions[1], params.claims),
     )
-    hulls = (
-        hull_offsets(dimensions[0], _static(tracks.vessels, a)),
-        hull_offsets(dimensions[1], _static(tracks.vessels, b)),
-    )
+    hulls = (hull_offsets(dimensions[0], statics[0]), hull_offsets(dimensions[1], statics[1]))
     lengths_m = (dimensions[0].length_m, dimensions[1].length_m)
     in_channel = tuple(
         vessel_in_channel(
@@ -631,18 +629,13 @@ def evaluate_pair(
         (in_channel[0], in_channel[1]),
         (float(series["own_cog_deg"].iloc[0]), float(series["target_cog_deg"].iloc[0])),
     )
+    at_trigger = [nav_status(series[f"{prefix}nav_status"].iloc[0]) for prefix in PREFIXES]
     standings = (
         None
         if channels is None or not any(c.is_area for c in channels)
-        else tuple(
-            channel_standing(
-                in_channel[i],
-                dimensions[i],
-                text_or_none(_static(tracks.vessels, mmsi).get("ship_type")),
-                claims[i].belief(nav_status(series[f"{prefix}nav_status"].iloc[0])),
-                nav_status(series[f"{prefix}nav_status"].iloc[0]),
-            )
-            for i, (mmsi, prefix) in enumerate(zip((a, b), PREFIXES, strict=True))
+        else (
+            channel_standing(in_channel[0], dimensions[0], statics[0], claims[0], at_trigger[0]),
+            channel_standing(in_channel[1], dimensions[1], statics[1], claims[1], at_trigger[1]),
         )
     )
     steps = _pair_steps(
@@ -653,7 +646,7 @@ def evaluate_pair(
         params,
         step_s,
         meeting,
-        None if standings is None else (standings[0], standings[1]),
+        standings,
     )
     trigger = series.iloc[0]
     vessels = tuple(
@@ -670,7 +663,7 @@ def evaluate_pair(
         interaction=interaction,
         swing_model=params.manoeuvrability.swing_model,
         in_channel=(in_channel[0], in_channel[1]),
-        standings=None if standings is None else (standings[0], standings[1]),
+        standings=standings,
     )
 
 
@@ -700,13 +693,16 @@ def _interaction(
 def channel_standing(
     place: VesselInChannel,
     dimensions: VesselDimensions,
-    ship_type: str | None,
-    belief: NavStatusBelief,
+    static: dict[str, Any],
+    claims: _Claims,
     status: int | None,
 ) -> ChannelStanding:
     """What rule 9's clauses read of a vessel: along or crossing a charted channel (at the
     trigger, or crossing at the least separation), under 20 m (a reported length) or
-    sailing, fishing (her AIS type, or a navigational status that is believed)."""
+    sailing, fishing (her AIS type, or her navigational status at the trigger where it is
+    believed)."""
+    ship_type = text_or_none(static.get("ship_type"))
+    belief = claims.belief(status)
     used = status if belief.believed else None
     length_known = "length_m" not in dimensions.defaulted
     relations = (place.at_trigger.relation, place.at_least_separation.relation)

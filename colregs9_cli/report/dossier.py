@@ -26,13 +26,12 @@ from matplotlib.figure import Figure
 
 from ..core.replay_results import EncounterOutcome
 from ..core.rows import EncounterSummary
+from .encounter_figure import OWN_TRACK_COLOUR, TARGET_COLOUR
 
 TIMELINE_STEP_S = 15.0
 TIMELINE_LONGER_STEPS_S = (30.0, 60.0, 120.0, 300.0, 600.0)
 TIMELINE_MOST_ROWS = 80
 TIME_FORMAT = "%H:%M:%S"
-OWN_COLOUR = "darkorange"
-TARGET_COLOUR = "black"
 
 
 @dataclass(frozen=True)
@@ -186,22 +185,6 @@ def _step_text(step_s: float) -> str:
     return f"{step_s:g} s" if step_s < 60 else f"{step_s / 60:g} min"
 
 
-def _gap_text(s: EncounterSummary, who: str) -> str:
-    gap_s = getattr(s, f"{who}_largest_report_gap_s")
-    if gap_s is None:
-        return f"{who}: no reports in the window"
-    sparse = getattr(s, f"{who}_reports_sparse")
-    note = (
-        ": sparse, she ran farther between two reports than the least separation, so her "
-        "track near it is interpolated, not seen"
-        if sparse
-        else ""
-    )
-    return f"{who} ship's longest gap between reports {gap_s:.0f} s{note}".replace(
-        "target ship's", "target's"
-    )
-
-
 def _place_text(channel: str | None, relation: str | None, offset_m: float | None) -> str:
     if channel is None:
         return "in no charted channel"
@@ -247,9 +230,23 @@ def channel_lines(s: EncounterSummary) -> list[str]:
     return lines
 
 
+def _gap_text(s: EncounterSummary, who: str, title: str) -> str:
+    gap_s = getattr(s, f"{who}_largest_report_gap_s")
+    if gap_s is None:
+        return f"{title}: no reports in the window"
+    sparse = getattr(s, f"{who}_reports_sparse")
+    note = (
+        ": sparse, she ran farther between two reports than the least separation, so her "
+        "track near it is interpolated, not seen"
+        if sparse
+        else ""
+    )
+    return f"{title}'s longest gap between reports {gap_s:.0f} s{note}"
+
+
 def report_gap_lines(s: EncounterSummary) -> list[str]:
     """Both vessels' longest report gaps over the passing, in words."""
-    return [_gap_text(s, "own"), _gap_text(s, "target")]
+    return [_gap_text(s, "own", "own ship"), _gap_text(s, "target", "target")]
 
 
 def timeline_html(outcome: EncounterOutcome) -> list[str]:
@@ -321,7 +318,7 @@ def motion_figure(outcome: EncounterOutcome) -> Figure:
     north = (series["target_north_m"] - series["own_north_m"]).to_numpy(dtype=float)
     east = (series["target_east_m"] - series["own_east_m"]).to_numpy(dtype=float)
     right.plot(east, north, color=TARGET_COLOUR, lw=1.2, label="target relative to own ship")
-    right.plot([0.0], [0.0], marker="^", color=OWN_COLOUR, ms=9, ls="", label="own ship")
+    right.plot([0.0], [0.0], marker="^", color=OWN_TRACK_COLOUR, ms=9, ls="", label="own ship")
     # The relative motion line the trigger predicted: from the target's relative position then
     # to where constant velocities put her at TCPA.
     (own_north, own_east), (target_north, target_east) = (

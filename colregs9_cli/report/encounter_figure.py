@@ -58,7 +58,8 @@ LEAST_SEPARATION_LABEL = "least separation"
 DEFAULTED_NOTE = "* dimension not in AIS: a default was used"
 
 
-def _cell(value: Any) -> Any:
+def cell(value: Any) -> Any:
+    """A summary value as a CSV/Markdown cell: enums by value, times in ISO 8601."""
     if isinstance(value, Enum):
         return value.value
     if isinstance(value, datetime | pd.Timestamp):
@@ -77,9 +78,9 @@ def verdict_text(outcome: EncounterOutcome) -> str:
     rule9 = "rule 9 applied" if s.rule9_applied else "rule 9 not applied"
     ambiguous = ", ambiguous" if s.situation_ambiguous else ""
     return (
-        f"{_cell(s.situation)}{ambiguous}: own ship {_cell(s.own_role_colregs)} → "
-        f"{_cell(s.own_role_final)} ({rule9}, {s.automaton_path}; rule {_cell(s.deciding_rule)})"
-        f"\ntarget restricted: {_cell(s.target_estimated_restricted)}, "
+        f"{cell(s.situation)}{ambiguous}: own ship {cell(s.own_role_colregs)} → "
+        f"{cell(s.own_role_final)} ({rule9}, {s.automaton_path}; rule {cell(s.deciding_rule)})"
+        f"\ntarget restricted: {cell(s.target_estimated_restricted)}, "
         f"CPA {s.cpa_m:.0f} m in {s.tcpa_s:.0f} s"
     )
 

@@ -11,8 +11,6 @@ import dataclasses
 import functools
 import math
 from collections.abc import Callable, Sequence
-from datetime import datetime
-from enum import Enum
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
@@ -30,7 +28,7 @@ from ..core.rows import (
 from ..core.rule9 import RULES_APPLIED
 from ..outputs import report_directory, save_figure, write_csv, write_json, write_text
 from .dossier import motion_figure, timeline_markdown
-from .encounter_figure import encounter_figure, verdict_text
+from .encounter_figure import cell, encounter_figure, verdict_text
 from .html_page import HTML_NAME
 from .html_report import page_title, replay_html
 from .replay_geopackage import (
@@ -53,15 +51,6 @@ MANIFEST_NAME = "run.json"
 MOTION_SUFFIX = "-motion.png"
 
 
-def _cell(value: Any) -> Any:
-    """A summary value as a CSV/Markdown cell: enums by value, times in ISO 8601."""
-    if isinstance(value, Enum):
-        return value.value
-    if isinstance(value, datetime | pd.Timestamp):
-        return value.isoformat()
-    return value
-
-
 # The navigational status codes of pairs.csv and encounters.csv.
 NAV_STATUS_COLUMNS = frozenset(
     {"nav_status_a", "nav_status_b", "own_nav_status", "target_nav_status"}
@@ -70,7 +59,7 @@ NAV_STATUS_COLUMNS = frozenset(
 
 def _summary_table(summaries: list[Any], columns: tuple[str, ...]) -> pd.DataFrame:
     records = [
-        {name: _cell(value) for name, value in dataclasses.asdict(summary).items()}
+        {name: cell(value) for name, value in dataclasses.asdict(summary).items()}
         for summary in summaries
     ]
     table = pd.DataFrame.from_records(records, columns=list(columns))
@@ -153,11 +142,11 @@ def format_summary(result: ReplayResult) -> str:
                 situation_or_interaction(s),
                 "yes" if s.situation_ambiguous else "",
                 _give_way_text(s),
-                "" if s.deciding_rule is None else _cell(s.deciding_rule),
+                "" if s.deciding_rule is None else cell(s.deciding_rule),
                 _number(s.cpa_m, 1),  # 149.8, not the 150 m threshold
                 _number(s.tcpa_s, 0),
                 _number(s.actual_min_separation_m, 1),
-                "" if s.give_way_vessel_acted is None else _cell(s.give_way_vessel_acted),
+                "" if s.give_way_vessel_acted is None else cell(s.give_way_vessel_acted),
             ]
         )
     widths = [max(len(str(row[i])) for row in rows) for i in range(len(SUMMARY_HEADER))]
@@ -214,12 +203,12 @@ def format_index(result: ReplayResult, plots: bool) -> str:
         links = f"[csv]({ENCOUNTER_DIR}/{s.encounter_id}.csv)"
         if plots:
             links += f" [png]({ENCOUNTER_DIR}/{s.encounter_id}.png)"
-        acted = "" if s.give_way_vessel_acted is None else _cell(s.give_way_vessel_acted)
+        acted = "" if s.give_way_vessel_acted is None else cell(s.give_way_vessel_acted)
         lines.append(
-            f"| {s.encounter_id} | {_cell(s.trigger_utc)} | {s.own_mmsi} | {s.target_mmsi} "
+            f"| {s.encounter_id} | {cell(s.trigger_utc)} | {s.own_mmsi} | {s.target_mmsi} "
             f"| {situation_or_interaction(s)} | {'yes' if s.situation_ambiguous else ''} "
-            f"| {_cell(s.own_role_colregs) or ''} | {_cell(s.target_estimated_restricted) or ''} "
-            f"| {s.automaton_path or ''} | {_cell(s.deciding_rule) or ''} | {_give_way_text(s)} "
+            f"| {cell(s.own_role_colregs) or ''} | {cell(s.target_estimated_restricted) or ''} "
+            f"| {s.automaton_path or ''} | {cell(s.deciding_rule) or ''} | {_give_way_text(s)} "
             f"| {_number(s.cpa_m, 0)} | {_number(s.actual_min_separation_m, 0)} | {acted} "
             f"| {links} |"
         )
