@@ -17,13 +17,16 @@ from colregs9_cli.core.audit import ConductParams, Fact, conduct
 from colregs9_cli.core.channel_audit import (
     NOT_CHARTED,
     ChannelAuditParams,
+    DraughtOnChart,
     vessel_in_channel,
 )
+from colregs9_cli.core.vessel_defaults import VesselDimensions
 from colregs9_cli.errors import ParameterError
 from colregs9_cli.geo import LocalFrame
 
 FRAME = LocalFrame(55.0, 10.0)
 PARAMS = ChannelAuditParams()
+NO_DEPTHS = DraughtOnChart(None, VesselDimensions(100.0, 15.0, 6.0, (), ""), 0.0)
 # A fairway 200 m wide running north-south for 4 km, its axis on x = 0 (east_m).
 FAIRWAY = make_channel(
     FRAME,
@@ -53,7 +56,7 @@ def _run(east_m: float, course_deg: float, seconds: int, start_north_m: float = 
 
 def _judge(window: pd.DataFrame, cpa_row: int | None = None, covers_cpa: bool = True):
     cpa = len(window) - 1 if cpa_row is None else cpa_row
-    return vessel_in_channel(window, "own_", CHANNELS, cpa, covers_cpa, 1.0, PARAMS)
+    return vessel_in_channel(window, "own_", CHANNELS, cpa, covers_cpa, 1.0, PARAMS, NO_DEPTHS)
 
 
 def test_northbound_in_the_eastern_half_keeps_to_starboard() -> None:
@@ -108,7 +111,7 @@ def test_outside_every_channel_and_without_a_chart() -> None:
     assert outside.at_trigger.relation is ChannelRelation.OUTSIDE
     assert outside.keeps_to_starboard_side.fact is None
     window = _run(50.0, 0.0, 60)
-    assert vessel_in_channel(window, "own_", None, 59, True, 1.0, PARAMS) == NOT_CHARTED
+    assert vessel_in_channel(window, "own_", None, 59, True, 1.0, PARAMS, NO_DEPTHS) == NOT_CHARTED
 
 
 def test_the_least_separation_place_is_its_row() -> None:
@@ -201,7 +204,7 @@ SCHEME = Channels(FRAME, (LANE,))
 def _in_scheme(east_m: float, course_deg: float, heading_deg: float | None = None):
     window = _run(east_m, course_deg, 120, start_north_m=-300.0 if course_deg < 90 else 300.0)
     window["own_heading_grid_deg"] = np.nan if heading_deg is None else heading_deg
-    return vessel_in_channel(window, "own_", SCHEME, 119, True, 1.0, PARAMS).lane
+    return vessel_in_channel(window, "own_", SCHEME, 119, True, 1.0, PARAMS, NO_DEPTHS).lane
 
 
 def test_rule_10_b_a_vessel_in_a_lane_goes_its_way() -> None:
@@ -216,12 +219,12 @@ def test_rule_10_b_a_vessel_in_a_lane_goes_its_way() -> None:
 def test_rule_10_c_a_lane_crossed_at_right_angles_by_heading() -> None:
     window = _run(0.0, 90.0, 240, start_north_m=0.0)  # east across the lane, 5 m/s
     window["own_heading_grid_deg"] = np.nan
-    square = vessel_in_channel(window, "own_", SCHEME, 239, True, 1.0, PARAMS).lane
+    square = vessel_in_channel(window, "own_", SCHEME, 239, True, 1.0, PARAMS, NO_DEPTHS).lane
     assert square.crosses_at_right_angles is Fact.TRUE and square.follows_lane is None
     assert "heading 0° from a right angle" in square.basis
     # the same track made good with her head 30° to port of it (set by a current): not square
     window["own_heading_grid_deg"] = 60.0
-    crabbing = vessel_in_channel(window, "own_", SCHEME, 239, True, 1.0, PARAMS).lane
+    crabbing = vessel_in_channel(window, "own_", SCHEME, 239, True, 1.0, PARAMS, NO_DEPTHS).lane
     assert crabbing.crosses_at_right_angles is Fact.FALSE
     assert "heading 30° from a right angle" in crabbing.basis
 
@@ -283,7 +286,7 @@ def test_following_a_bend_is_no_turn_and_a_turn_within_it_is(
     extra_turn_deg: float, action: str
 ) -> None:
     window = _round_the_bend(extra_turn_deg)
-    found = vessel_in_channel(window, "own_", RIVER, len(window) - 1, True, 1.0, PARAMS)
+    found = vessel_in_channel(window, "own_", RIVER, len(window) - 1, True, 1.0, PARAMS, NO_DEPTHS)
     # 60° of bend between the first row and the last, less her own extra turn
     assert found.bend_deg[-1] == pytest.approx(60.0, abs=4.0)
     true_course = window["own_cog_grid_deg"].to_numpy()

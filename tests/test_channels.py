@@ -32,6 +32,7 @@ from colregs9_cli.errors import ChartError, ParameterError
 from colregs9_cli.geo import LocalFrame
 
 from fixture_files import FIXTURES, SANDIEGO_ENC
+from geojson_charts import feature, write_chart
 
 ANNAPOLIS_ENC = FIXTURES / "charts" / "noaa_enc_US5MD1MC.000"
 FRAME = LocalFrame(55.0, 10.0)
@@ -209,27 +210,10 @@ def test_offsets_of_a_rotated_channel(
 # -- charts written as GeoJSON in FRAME's metres ---------------------------------------------
 
 
-def _feature(properties: dict[str, Any], geometry: Any) -> dict[str, Any]:
-    (wgs84,) = FRAME.shapes_to_wgs84([geometry])
-    return {
-        "type": "Feature",
-        "properties": properties,
-        "geometry": json.loads(shapely.to_geojson(wgs84)),
-    }
-
-
 def _chart(
     path: Path, *features: tuple[dict[str, Any], Any], box_m: float = 3000.0, **detail: Any
 ) -> Path:
-    square = shapely.box(-box_m, -box_m, box_m, box_m)
-    collection = [
-        _feature({"OBJL": "M_COVR", "CATCOV": 1, **detail}, square),
-        *(_feature(p, g) for p, g in features),
-    ]
-    if not any(p.get("OBJL") == "DEPARE" for p, _ in features):
-        collection.append(_feature({"OBJL": "DEPARE", "DRVAL1": 30.0}, square))
-    path.write_text(json.dumps({"type": "FeatureCollection", "features": collection}))
-    return path
+    return write_chart(path, FRAME, *features, box_m=box_m, **detail)
 
 
 def _load(*paths: Path) -> Channels:
@@ -307,10 +291,12 @@ def test_where_charts_overlap_the_more_detailed_decides(tmp_path: Path) -> None:
             {
                 "type": "FeatureCollection",
                 "features": [
-                    _feature({"OBJL": "M_COVR", "CATCOV": 1, "INTU": 5}, half),
-                    _feature({"OBJL": "DEPARE", "DRVAL1": 12.0}, half),
-                    _feature(
-                        {"OBJL": "FAIRWY", "OBJNAM": "Harbour"}, shapely.box(-100, 0, 100, 2500)
+                    feature(FRAME, {"OBJL": "M_COVR", "CATCOV": 1, "INTU": 5}, half),
+                    feature(FRAME, {"OBJL": "DEPARE", "DRVAL1": 12.0}, half),
+                    feature(
+                        FRAME,
+                        {"OBJL": "FAIRWY", "OBJNAM": "Harbour"},
+                        shapely.box(-100, 0, 100, 2500),
                     ),
                 ],
             }

@@ -219,3 +219,34 @@ def test_the_dossier_names_the_channel_and_rule_9a(sandiego_replay) -> None:
         "rule 9 not applied though the estimator found a vessel restricted: she is in no "
         "charted channel"
     )
+
+
+def test_a_long_legend_leaves_the_title_and_the_axis_labels_in_the_figure(sandiego_replay) -> None:
+    # The San Diego chart adds the channel, its axis and "not charted" to the legend: the
+    # figure grows for them, so that nothing is cut off or drawn over, as a reader sees it.
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from colregs9_cli.charts.water import load_chart
+
+    from fixture_files import SANDIEGO_ENC
+
+    (outcome,) = [
+        o
+        for o in sandiego_replay.encounters
+        if (o.summary.own_name, o.summary.target_name) == ("TRADITION", "CHAMPAGNE")
+    ]
+    chart = load_chart([SANDIEGO_ENC], frame=sandiego_replay.frame)
+    figure = encounter_figure(outcome, chart, 0.0, sandiego_replay.frame)
+    renderer = FigureCanvasAgg(figure).get_renderer()
+    figure.draw(renderer)
+    (ax, _colourbar) = figure.axes
+    (legend,) = figure.legends
+    labels = [text.get_text() for text in legend.get_texts()]
+    assert {"charted channel", "channel axis", "not charted"} <= set(labels)
+    whole = figure.bbox
+    title = ax.title.get_window_extent(renderer)
+    assert whole.y0 <= title.y0 and title.y1 <= whole.y1 and title.x0 >= whole.x0
+    xlabel = ax.xaxis.label.get_window_extent(renderer)
+    box = legend.get_window_extent(renderer)
+    assert xlabel.y0 > box.y1  # the axis label above the legend, not under it
+    assert whole.y0 <= box.y0

@@ -327,11 +327,19 @@ def test_every_pair_verdict_is_consistent(
 # -- which clause of rule 9, with the chart's channels --------------------------------------
 
 
+_NAMES = (
+    "along_channel",
+    "crossing_channel",
+    "small_or_sailing",
+    "fishing",
+    "confined_to_channel",
+)
+
+
 def _standing(**flags: bool):
     from colregs9_cli.core.rule9 import ChannelStanding
 
-    names = ("along_channel", "crossing_channel", "small_or_sailing", "fishing")
-    values = dict.fromkeys(names, False)
+    values = dict.fromkeys(_NAMES, False)
     return ChannelStanding(**{**values, **flags})
 
 
@@ -400,11 +408,48 @@ def test_with_the_channels_known_rule_9_inverts_only_where_a_clause_binds(
     assert paper.rule9_applied and paper.rule9_clause.value == "estimator"
 
 
+@pytest.mark.parametrize("estimate", ["false", "unknown"])
+def test_a_vessel_her_draught_confines_to_the_channel_is_restricted_for_d3(estimate) -> None:
+    # A crossing in which b gives way under rule 15, but b proceeds along a channel her
+    # draught confines her to; a, a yacht under 20 m, shall not impede her (9(b)). The
+    # estimator's own verdict about b does not matter: d3 holds by the chart.
+    flipped = (Role.STAND_ON, Role.GIVE_WAY)
+    confined = _standing(along_channel=True, confined_to_channel=True)
+    verdict = decide_pair(
+        Situation.CROSSING,
+        flipped,
+        (None, None),
+        ("false", estimate),
+        channels=(_standing(small_or_sailing=True), confined),
+    )
+    assert verdict.seat_a.path_text == "D1>D2>D3>D4" and verdict.seat_a.d3 is Finding.TRUE
+    assert verdict.rule9_applied and verdict.rule9_clause.value == "9(b)"
+    assert verdict.role_final == (Role.GIVE_WAY, Role.STAND_ON)
+    # Along the channel but with room outside it: the estimator's verdict stands alone.
+    free = decide_pair(
+        Situation.CROSSING,
+        flipped,
+        (None, None),
+        ("false", estimate),
+        channels=(_standing(small_or_sailing=True), _standing(along_channel=True)),
+    )
+    assert not free.rule9_applied and free.role_final == flipped
+    assert free.seat_a.path_text == "D1>D2>D3>D1"
+    # Two vessels along the channel, both confined: rule 9 does not choose between them.
+    both = decide_pair(
+        Situation.HEAD_ON,
+        (Role.GIVE_WAY, Role.GIVE_WAY),
+        (None, None),
+        ("false", "false"),
+        channels=(confined, confined),
+    )
+    assert both.both_restricted and not both.rule9_applied
+
+
 _STANDINGS = st.builds(
     lambda *flags: _standing(**dict(zip(_NAMES, flags, strict=True))),
-    *(st.booleans() for _ in range(4)),
+    *(st.booleans() for _ in _NAMES),
 )
-_NAMES = ("along_channel", "crossing_channel", "small_or_sailing", "fishing")
 
 
 @given(

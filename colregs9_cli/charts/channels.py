@@ -399,34 +399,15 @@ class Channels:
         q = np.flatnonzero((index >= 0) & np.isfinite(bearing) & np.isfinite(north + east))
         if len(q) == 0:
             return Sections(left, right)
-        areas = self._area_geometries(draught_m, ukc_m)[index[q]]
         bearing_rad = np.radians(bearing[q])
         right_unit = np.column_stack([np.cos(bearing_rad), -np.sin(bearing_rad)])
-        centre = np.column_stack([east[q], north[q]])
-        reach = self._reach_m[index[q]][:, None]
-        lines = shapely.linestrings(
-            np.stack([centre - reach * right_unit, centre + reach * right_unit], axis=1)
+        reach = self._reach_m[index[q]]
+        left[q], right[q] = section_extents(
+            np.column_stack([east[q], north[q]]),
+            right_unit,
+            (reach, reach),
+            self._area_geometries(draught_m, ukc_m)[index[q]],
         )
-        pieces, owner = shapely.get_parts(
-            shapely.line_merge(shapely.intersection(lines, areas)), return_index=True
-        )
-        pieces = np.asarray(pieces, dtype=object)
-        holds = np.asarray(
-            shapely.dwithin(pieces, shapely.points(centre[owner]), 1e-6), dtype=bool
-        ) & np.isin(shapely.get_type_id(pieces), _LINE_TYPES)
-        pieces, owner = pieces[holds], owner[holds]
-        ends = np.stack(
-            [
-                shapely.get_coordinates(shapely.get_point(pieces, 0)),
-                shapely.get_coordinates(shapely.get_point(pieces, -1)),
-            ],
-            axis=1,
-        )
-        along = np.einsum("kij,kj->ki", ends - centre[owner][:, None, :], right_unit[owner])
-        # Pieces met in order along the section: the first holding the position decides.
-        first = np.unique(owner, return_index=True)[1]
-        right[q[owner[first]]] = np.maximum(along[first].max(axis=1), 0.0)
-        left[q[owner[first]]] = np.maximum(-along[first].min(axis=1), 0.0)
         return Sections(left, right)
 
     def width_m_at(
@@ -460,6 +441,52 @@ class Channels:
             water = self.chart.navigable_water(draught_m, ukc_m)
             self._water[key] = np.asarray(shapely.intersection(geometries, water), dtype=object)
         return self._water[key]
+
+
+def section_extents(
+    centre_xy: NDArray[np.float64],
+    right_unit: NDArray[np.float64],
+    reach_m: tuple[NDArray[np.float64], NDArray[np.float64]],
+    areas: NDArray[np.object_],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """For each point (``centre_xy``: x = east, y = north) and the unit vector to its right
+    (``right_unit``), the straight piece of ``areas[i]`` along the line square to the
+    direction that holds the point, from ``reach_m[0][i]`` on its left to ``reach_m[1][i]``
+    on its right: how far the piece reaches to the left and to the right (each at most the
+    reach). NaN where no piece holds the point."""
+    left, right = np.full(len(centre_xy), np.nan), np.full(len(centre_xy), np.nan)
+    if len(centre_xy) == 0:
+        return left, right
+    lines = shapely.linestrings(
+        np.stack(
+            [
+                centre_xy - reach_m[0][:, None] * right_unit,
+                centre_xy + reach_m[1][:, None] * right_unit,
+            ],
+            axis=1,
+        )
+    )
+    pieces, owner = shapely.get_parts(
+        shapely.line_merge(shapely.intersection(lines, areas)), return_index=True
+    )
+    pieces = np.asarray(pieces, dtype=object)
+    holds = np.asarray(
+        shapely.dwithin(pieces, shapely.points(centre_xy[owner]), 1e-6), dtype=bool
+    ) & np.isin(shapely.get_type_id(pieces), _LINE_TYPES)
+    pieces, owner = pieces[holds], owner[holds]
+    ends = np.stack(
+        [
+            shapely.get_coordinates(shapely.get_point(pieces, 0)),
+            shapely.get_coordinates(shapely.get_point(pieces, -1)),
+        ],
+        axis=1,
+    )
+    along = np.einsum("kij,kj->ki", ends - centre_xy[owner][:, None, :], right_unit[owner])
+    # Pieces met in order along the section: the first holding the point decides.
+    first = np.unique(owner, return_index=True)[1]
+    right[owner[first]] = np.maximum(along[first].max(axis=1), 0.0)
+    left[owner[first]] = np.maximum(-along[first].min(axis=1), 0.0)
+    return left, right
 
 
 def _points_xy(

@@ -51,6 +51,7 @@ from .audit import (
 from .channel_audit import (
     NOT_CHARTED,
     ChannelAuditParams,
+    DraughtOnChart,
     VesselInChannel,
     meeting_along_a_channel,
     vessel_in_channel,
@@ -180,7 +181,7 @@ class PairEvaluation:
 
     @property
     def rule9_clause(self) -> Rule9Clause | None:
-        """Where the estimator found the vessel that rule 9 would make stand on restricted:
+        """Where d3 found the vessel that rule 9 would make stand on restricted:
         the clause that binds the other (``rule9.decide_pair``); None where it did not."""
         return self.verdict.rule9_clause
 
@@ -619,8 +620,9 @@ def evaluate_pair(
             seen.covers_cpa,
             step_s,
             params.channels,
+            DraughtOnChart(chart, dimensions[i], params.manoeuvrability.ukc_m),
         )
-        for prefix in PREFIXES
+        for i, prefix in enumerate(PREFIXES)
     )
     bends = (in_channel[0].bend_deg, in_channel[1].bend_deg)
     audit = audit_pair(window, seen, hulls, lengths_m, params.conduct, step_s, bends)
@@ -700,7 +702,7 @@ def channel_standing(
     """What rule 9's clauses read of a vessel: along or crossing a charted channel (at the
     trigger, or crossing at the least separation), under 20 m (a reported length) or
     sailing, fishing (her AIS type, or her navigational status at the trigger where it is
-    believed)."""
+    believed), confined to the channel by her draught at the trigger."""
     ship_type = text_or_none(static.get("ship_type"))
     belief = claims.belief(status)
     used = status if belief.believed else None
@@ -713,6 +715,7 @@ def channel_standing(
         or ship_type == "Sailing"
         or used == NavStatus.UNDER_WAY_SAILING,
         fishing=ship_type == "Fishing" or used == NavStatus.ENGAGED_IN_FISHING,
+        confined_to_channel=place.confined.fact is Fact.TRUE,
     )
 
 

@@ -111,6 +111,10 @@ class PairSummary:
     crosses_lane_at_right_angles_b: Fact | None
     traffic_lane_basis_a: str | None
     traffic_lane_basis_b: str | None
+    confined_to_channel_a: Fact | None
+    confined_to_channel_b: Fact | None
+    confined_to_channel_basis_a: str | None
+    confined_to_channel_basis_b: str | None
     give_way_vessel_acted: Fact | None
     give_way_action: str | None
     give_way_action_as_rule_asks: Fact | None
@@ -170,6 +174,10 @@ PAIR_VERDICT_COLUMNS: tuple[str, ...] = (
     "crosses_lane_at_right_angles_b",
     "traffic_lane_basis_a",
     "traffic_lane_basis_b",
+    "confined_to_channel_a",
+    "confined_to_channel_b",
+    "confined_to_channel_basis_a",
+    "confined_to_channel_basis_b",
 )
 
 
@@ -264,6 +272,10 @@ class EncounterSummary:
     target_crosses_lane_at_right_angles: Fact | None
     own_traffic_lane_basis: str | None
     target_traffic_lane_basis: str | None
+    own_confined_to_channel: Fact | None
+    target_confined_to_channel: Fact | None
+    own_confined_to_channel_basis: str | None
+    target_confined_to_channel_basis: str | None
     give_way_vessel_acted: Fact | None
     give_way_action: str | None
     give_way_action_as_rule_asks: Fact | None
@@ -320,6 +332,10 @@ ENCOUNTER_VERDICT_COLUMNS: tuple[str, ...] = (
     "target_crosses_lane_at_right_angles",
     "own_traffic_lane_basis",
     "target_traffic_lane_basis",
+    "own_confined_to_channel",
+    "target_confined_to_channel",
+    "own_confined_to_channel_basis",
+    "target_confined_to_channel_basis",
 )
 # The series columns of the verdict, empty for the other interactions.
 SERIES_VERDICT_COLUMNS: tuple[str, ...] = (
@@ -438,6 +454,8 @@ def _channel_fields(vessel: VesselInChannel, name: str) -> dict[str, Any]:
         name.format("follows_lane_direction"): vessel.lane.follows_lane,
         name.format("crosses_lane_at_right_angles"): vessel.lane.crosses_at_right_angles,
         name.format("traffic_lane_basis"): vessel.lane.basis,
+        name.format("confined_to_channel"): vessel.confined.fact,
+        name.format("confined_to_channel_basis"): vessel.confined.basis,
     }
 
 

@@ -16,8 +16,12 @@ and the transition function ``TRANSITIONS`` (exactly the figure's six arrows):
 Events, as in the paper: d1 the target needs to give way under rules 13–15 (a crossing or
 overtaking in which own ship stands on, and every head-on); d2 the target's AIS navigational
 status is in the restricted set (``Rule9Params.restricted_nav_statuses``, default {3, 4});
-d3 the manoeuvrability estimator says the target is restricted. The estimator's "unknown" is
-¬d3, recorded as ``unknown`` and never as "not restricted"; so is a missing nav status for d2.
+d3 the manoeuvrability estimator says the target is restricted, or, where the chart charts
+channels, she proceeds along one to which her draught confines her (the water navigable for
+her ends within her length of its limits on both hands: ``channel_audit.confined_to_channel``,
+rule 9(b)'s "a vessel which can safely navigate only within a narrow channel"). The
+estimator's "unknown" is ¬d3, recorded as ``unknown`` and never as "not restricted"; so is a
+missing nav status for d2.
 D4 means the target is not expected to give way: she stands on and own ship gives way.
 
 One assessment runs the automaton from D1 until it reaches a marked state after at least one
@@ -31,12 +35,13 @@ the same give-way vessel(s). This module is the one place that decides them:
 1. No situation: no roles.
 2. Overtaking: rule 13 keeps the roles whatever either vessel reports or is estimated (rule 18
    opens "except where Rules 9, 10 and 13 otherwise require"); the paths are still recorded.
-3. A vessel is restricted when the other seat's G_d reached D4 about her (she had to give
-   way and is restricted), or, even as the stand-on vessel, when her AIS status claims it (a
-   status in the restricted set, or not under command, restricted, constrained by her
-   draught) or the estimator finds her restricted. Exactly one restricted vessel stands on
-   and the other gives way; the deciding rule is 9 when the estimator said so (d3: she can
-   navigate safely only within the channel), 18 when her AIS status did.
+3. A vessel is restricted when the other seat's G_d reached D4 about her (she had to give way
+   and is restricted), or, even as the stand-on vessel, when her AIS status claims it (a status
+   in the restricted set, or not under command, restricted, constrained by her draught) or d3
+   holds of her (the estimator, or her draught in a channel). Exactly one restricted vessel
+   stands on and the other gives way; the deciding rule is 9 when d3 said so (she can navigate
+   safely only within the channel), 18 when her AIS status did. With the chart's channels, rule
+   9 decides only where a clause binds the other vessel (``rule9_clause``).
 4. Both restricted: the rules 13–15 roles stay, flagged ``both_restricted``. Rule 9 asks
    the vessel that can leave the channel to keep out of the way of one that cannot; when
    neither can, it does not choose between them.
@@ -273,7 +278,7 @@ class PairVerdict:
     role_final: tuple[Role, Role]
     deciding_rule: DecidingRule
     both_restricted: bool
-    # Where the estimator found the vessel that rule 9 would make stand on restricted: the
+    # Where d3 found the vessel that rule 9 would make stand on restricted: the
     # clause that binds the other (``rule9_clause``); None where it did not arise.
     rule9_clause: Rule9Clause | None = None
 
@@ -306,6 +311,13 @@ def decide_pair(
     estimator alone decides, as in the paper.
     """
     role_a, role_b = role_colregs
+    # d3 with the chart's channels: the estimator's arcs, or her draught confining her to
+    # the channel she proceeds along.
+    if channels is not None:
+        estimated_restricted = (
+            "true" if channels[0].confined_to_channel else estimated_restricted[0],
+            "true" if channels[1].confined_to_channel else estimated_restricted[1],
+        )
     seat_a = assess_rule9(role_b, nav_status[1], estimated_restricted[1], restricted_nav_statuses)
     seat_b = assess_rule9(role_a, nav_status[0], estimated_restricted[0], restricted_nav_statuses)
     # A vessel is restricted when G_d reached D4 about her, or when her AIS status or the
@@ -328,8 +340,8 @@ def decide_pair(
             by_restriction = (
                 (Role.STAND_ON, Role.GIVE_WAY) if restricted[0] else (Role.GIVE_WAY, Role.STAND_ON)
             )
-            by_estimator = about_restricted.d3 is Finding.TRUE
-            if by_restriction != final and by_estimator:
+            by_d3 = about_restricted.d3 is Finding.TRUE
+            if by_restriction != final and by_d3:
                 which = 0 if restricted[0] else 1
                 clause = (
                     Rule9Clause.ESTIMATOR
@@ -337,9 +349,9 @@ def decide_pair(
                     else rule9_clause(channels[which], channels[1 - which])
                 )
             binds = channels is None or clause not in (Rule9Clause.ESTIMATOR, Rule9Clause.NO_CLAUSE)
-            if by_restriction != final and (binds or not by_estimator):
+            if by_restriction != final and (binds or not by_d3):
                 final = by_restriction
-                rule = DecidingRule.RULE_9 if by_estimator else DecidingRule.RULE_18
+                rule = DecidingRule.RULE_9 if by_d3 else DecidingRule.RULE_18
         elif not restricted[0]:
             rank_a, rank_b = rule18_rank(nav_status[0]), rule18_rank(nav_status[1])
             by_rank = (
@@ -385,22 +397,27 @@ class Rule9Clause(StrEnum):
 @dataclass(frozen=True)
 class ChannelStanding:
     """What the clauses of rule 9 read about one vessel: whether she proceeds along a
-    charted channel, crosses one, is under 20 m or a sailing vessel, or is fishing."""
+    charted channel, crosses one, is under 20 m or a sailing vessel, is fishing, or can
+    safely navigate only within the channel she proceeds along, her draught confining her."""
 
     along_channel: bool
     crossing_channel: bool
     small_or_sailing: bool
     fishing: bool
+    # Along a charted channel, and the water navigable for her draught ends within her
+    # length of its limits on both hands (``channel_audit.confined_to_channel``).
+    confined_to_channel: bool = False
 
 
 def rule9_clause(restricted: ChannelStanding, other: ChannelStanding) -> Rule9Clause:
     """The clause of rule 9 under which ``other`` keeps out of the way of ``restricted``, the
-    vessel rule 9 made stand on (the estimator found that she can safely navigate only
-    within the channel): 9(d) when the other crosses the channel, 9(b) when she is under
-    20 m or sailing, 9(c) when she is fishing; ``none`` when the restricted vessel proceeds
-    along a charted channel and none of these binds the other (two ships along it: rule 9
-    then asks each to keep to her starboard side, 9(a), and does not invert rules 13-15;
-    the paper's estimator did); ``estimator`` where no charted channel holds her."""
+    vessel rule 9 made stand on (d3: the estimator, or her draught in the channel, found that
+    she can safely navigate only within the channel): 9(d) when the other crosses the channel,
+    9(b) when she is under 20 m or sailing, 9(c) when she is fishing; ``none`` when the
+    restricted vessel proceeds along a charted channel and none of these binds the other (two
+    ships along it: rule 9 then asks each to keep to her starboard side, 9(a), and does not
+    invert rules 13-15; the paper's estimator did); ``estimator`` where no charted channel holds
+    her."""
     if not restricted.along_channel:
         return Rule9Clause.ESTIMATOR
     if other.crossing_channel:

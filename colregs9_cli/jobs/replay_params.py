@@ -122,6 +122,7 @@ class ReplayParams:
     starboard_side_share: float = 0.8
     starboard_side_min_s: float = 30.0
     lane_crossing_within_deg: float = 15.0
+    channel_confined_within_lengths: float = 1.0
 
     @property
     def tracks(self) -> TrackParams:

@@ -217,16 +217,20 @@ def channel_lines(s: EncounterSummary) -> list[str]:
         if fact is not None:
             basis = getattr(s, f"{who}_keeps_to_starboard_side_basis")
             line += f"; rule 9(a), keeps to her starboard side: {fact.value} ({basis})"
+        confined = getattr(s, f"{who}_confined_to_channel")
+        if confined is not None:
+            basis = getattr(s, f"{who}_confined_to_channel_basis")
+            line += f"; confined to the channel by her draught: {confined.value} ({basis})"
         lines.append(line)
     if s.rule9_clause is not None and s.rule9_applied:
         lines.append(f"rule 9 decided under clause {s.rule9_clause.value}")
     elif s.rule9_clause is not None:
         why = (
-            "she is in no charted channel"
+            "the estimator found a vessel restricted: she is in no charted channel"
             if s.rule9_clause.value == "estimator"
-            else "no clause of rule 9(b)-(d) binds the other vessel"
+            else "a vessel was found restricted: no clause of rule 9(b)-(d) binds the other vessel"
         )
-        lines.append(f"rule 9 not applied though the estimator found a vessel restricted: {why}")
+        lines.append(f"rule 9 not applied though {why}")
     return lines
 
 

@@ -309,10 +309,20 @@ def _mark_least_separation(ax: Any, outcome: EncounterOutcome) -> None:
     )
 
 
+# The map's figure, whose height holds a legend of up to LEGEND_ROWS_IN_HEIGHT rows; each
+# row more adds LEGEND_ROW_IN (a line of small text and its spacing).
+FIGURE_WIDTH_IN = 8.5
+FIGURE_HEIGHT_IN = 9.2
+LEGEND_ROWS_IN_HEIGHT = 8
+LEGEND_ROW_IN = 0.22
+
+
 def _legend_below(figure: Figure, ax: Any) -> None:
     """A compact legend under the axes, so that it covers nothing: own ship, then the arcs
     and the chart, in one column; the target, then the ellipses, in the other, and what
-    ``*`` means when a vessel's label has one."""
+    ``*`` means when a vessel's label has one. The figure grows by the rows past
+    ``LEGEND_ROWS_IN_HEIGHT``, so that a long legend does not squeeze the map and its title
+    out of the figure."""
     handles, labels = ax.get_legend_handles_labels()
     entries = list(zip(handles, labels, strict=True))
     own = [
@@ -333,6 +343,8 @@ def _legend_below(figure: Figure, ax: Any) -> None:
     rows = max(len(c) for c in columns)
     # matplotlib fills a legend column by column: pad each to the same height.
     padded = [entry for c in columns for entry in c + [blank] * (rows - len(c))]
+    extra_rows = max(0, rows - LEGEND_ROWS_IN_HEIGHT)
+    figure.set_figheight(FIGURE_HEIGHT_IN + extra_rows * LEGEND_ROW_IN)
     figure.legend(
         [h for h, _ in padded],
         [label for _, label in padded],
@@ -399,7 +411,7 @@ def encounter_figure(
     trigger and of the predicted CPA.
     """
     s = outcome.summary
-    figure = Figure(figsize=(8.5, 9.2), layout="constrained")
+    figure = Figure(figsize=(FIGURE_WIDTH_IN, FIGURE_HEIGHT_IN), layout="constrained")
     ax = figure.subplots()
     view = _view_box(outcome)
     # The chart lives in the run's frame; a pair beyond its reach has a frame of its own.
