@@ -1,4 +1,5 @@
-"""Imports point down: no two modules of the package import each other."""
+"""Imports point down: no two modules of the package import each other, and none imports
+another's private (underscore) names."""
 
 from __future__ import annotations
 
@@ -15,15 +16,27 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+def _package_of(path: Path) -> str:
+    """The package that ``path``'s relative imports start from."""
+    name = _module_name(path)
+    return name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+
+
+def _source_module(node: ast.ImportFrom, package: str) -> str:
+    """The module a ``from … import`` reads from, a relative one resolved in ``package``."""
+    if not node.level:
+        return node.module or ""
+    base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
+    return ".".join([*base, *([node.module] if node.module else [])])
+
+
 def _imports(path: Path) -> set[str]:
     """The package modules ``path`` imports (relative imports resolved)."""
-    name = _module_name(path)
-    package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+    package = _package_of(path)
     found: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.ImportFrom) and node.level:
-            base = package.split(".")[: len(package.split(".")) - (node.level - 1)]
-            module = ".".join([*base, *([node.module] if node.module else [])])
+            module = _source_module(node, package)
             found.add(module)
             found.update(f"{module}.{alias.name}" for alias in node.names)
         elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("colregs9_cli"):
@@ -97,6 +110,50 @@ def test_the_contract_sees_a_forbidden_import() -> None:
     assert _layer("colregs9_cli.jobs.replay") in FORBIDDEN["core"]
     assert _layer("colregs9_cli.geo") == "base" and "core" in FORBIDDEN["base"]
     assert _layer("colregs9_cli.cli") is None
+
+
+def _private_imports(tree: ast.AST, package: str) -> list[str]:
+    """``module.name`` for each underscore name imported from a package module; dunders
+    (``__version__``) are not private, and ``__future__`` is no package module."""
+    found: list[str] = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.ImportFrom):
+            continue
+        module = _source_module(node, package)
+        if not module.startswith("colregs9_cli"):
+            continue
+        for alias in node.names:
+            dunder = alias.name.startswith("__") and alias.name.endswith("__")
+            if alias.name.startswith("_") and not dunder:
+                found.append(f"{module}.{alias.name}")
+    return found
+
+
+def test_no_module_imports_another_modules_private_names() -> None:
+    """A name that another module uses is part of its module's interface: it has no
+    leading underscore."""
+    found = [
+        f"{_module_name(path)} imports {name}"
+        for path in sorted(PACKAGE.rglob("*.py"))
+        for name in _private_imports(ast.parse(path.read_text(encoding="utf-8")), _package_of(path))
+    ]
+    assert found == []
+
+
+def test_the_contract_sees_a_private_import() -> None:
+    """The check above can fail: an underscore name from a sibling module is found, and
+    ``__future__``, dunders and other packages' names are let through."""
+    source = (
+        "from __future__ import annotations\n"
+        "from .. import __version__\n"
+        "from .read import _Features, read_features\n"
+        "from colregs9_cli.geo import _private\n"
+        "from numpy import _typing\n"
+    )
+    assert _private_imports(ast.parse(source), "colregs9_cli.charts") == [
+        "colregs9_cli.charts.read._Features",
+        "colregs9_cli.geo._private",
+    ]
 
 
 def test_no_module_or_function_is_too_long() -> None:

@@ -21,7 +21,7 @@ import pyogrio
 from pyogrio.errors import DataLayerError, DataSourceError, FieldError
 
 from ..errors import ChartError
-from .gdal_layers import S57_OPEN_OPTIONS, _gdal_quiet
+from .gdal_layers import S57_OPEN_OPTIONS, gdal_quiet
 from .s57_records import record_count
 from .s57_updates import applied_updates, update_files_beside
 
@@ -29,23 +29,24 @@ from .s57_updates import applied_updates, update_files_beside
 def cell_purpose(intu: Any, path: Path) -> int:
     """A cell's navigational purpose, 1 (overview) … 6 (berthing): DSID INTU, else the digit
     in the third character of its name (``US5CA72M``: 5, harbour), else 0 (unknown)."""
-    purpose = _whole_number(intu)
+    purpose = whole_number(intu)
     if purpose is not None and 1 <= purpose <= 6:
         return purpose
     digit = Path(path).name[2:3]
     return int(digit) if digit.isdigit() and 1 <= int(digit) <= 6 else 0
 
 
-def _whole_number(value: Any) -> int | None:
+def whole_number(value: Any) -> int | None:
+    """An S-57 integer field's value; None where it is empty or not a whole number."""
     return int(value) if value is not None and str(value).strip().isdigit() else None
 
 
-def _dsid_fields(path: Path, apply_updates: bool = True) -> dict[str, Any]:
+def dsid_fields(path: Path, apply_updates: bool = True) -> dict[str, Any]:
     """The DSID record of an S-57 cell (after its updates, unless not ``apply_updates``: the
     file's own; an update file's own too), or nothing when GDAL has none."""
     options = {**S57_OPEN_OPTIONS, "UPDATES": "APPLY" if apply_updates else "IGNORE"}
     try:
-        with _gdal_quiet():
+        with gdal_quiet():
             meta, _, _, values = pyogrio.raw.read(
                 path, layer="DSID", read_geometry=False, **options
             )
@@ -90,21 +91,21 @@ def s57_cell_info(path: Path, accept_gaps: bool = False) -> CellInfo:
         )
     records = _whole_records(path, updates)
     _check_update_identities(path, applied_updates(updates, missing))
-    fields = _dsid_fields(path)
+    fields = dsid_fields(path)
     _check_all_records(path, records, fields)
-    _check_updates_applied(path, updates, missing, _whole_number(fields.get("DSID_UPDN")))
-    _check_depth_unit(path, fields.get("DSPM_DUNI"))
+    _check_updates_applied(path, updates, missing, whole_number(fields.get("DSID_UPDN")))
+    check_depth_unit(path, fields.get("DSPM_DUNI"))
     issue = fields.get("DSID_ISDT")
     return CellInfo(
         path=path,
         name=str(fields.get("DSID_DSNM") or path.name),
-        edition=_whole_number(fields.get("DSID_EDTN")),
-        update_number=_whole_number(fields.get("DSID_UPDN")),
+        edition=whole_number(fields.get("DSID_EDTN")),
+        update_number=whole_number(fields.get("DSID_UPDN")),
         issue_date=None if not issue else str(issue),
         update_files=tuple(updates),
         missing_updates=tuple(missing),
         purpose=cell_purpose(fields.get("DSID_INTU"), path),
-        scale=_whole_number(fields.get("DSPM_CSCL")),
+        scale=whole_number(fields.get("DSPM_CSCL")),
     )
 
 
@@ -135,16 +136,16 @@ def _check_update_identities(path: Path, updates: Sequence[Path]) -> None:
     (``_check_updates_applied``) would blame the wrong file."""
     if not updates:
         return
-    base = _dsid_fields(path, apply_updates=False)
+    base = dsid_fields(path, apply_updates=False)
     cell = Path(str(base.get("DSID_DSNM") or path.name)).stem
-    edition = _whole_number(base.get("DSID_EDTN"))
+    edition = whole_number(base.get("DSID_EDTN"))
     for update in updates:
-        own = _dsid_fields(update, apply_updates=False)
+        own = dsid_fields(update, apply_updates=False)
         if not own:  # not readable as S-57: the check after reading names it
             continue
         name = Path(str(own.get("DSID_DSNM") or update.name)).stem
-        its_edition = _whole_number(own.get("DSID_EDTN"))
-        number = _whole_number(own.get("DSID_UPDN"))
+        its_edition = whole_number(own.get("DSID_EDTN"))
+        number = whole_number(own.get("DSID_UPDN"))
         expected = int(update.suffix[1:])
         if (name, its_edition, number) != (cell, edition, expected):
             raise ChartError(
@@ -164,11 +165,11 @@ def _check_all_records(path: Path, found: int, fields: Mapping[str, Any]) -> Non
     """The base cell holds every record its DSSI field lists, besides its data descriptive
     record (GDAL reads a cell cut between two records without a word, the features of the
     missing records gone)."""
-    counts = [_whole_number(fields.get(f"DSSI_{name}")) for name in _DSSI_COUNTS]
+    counts = [whole_number(fields.get(f"DSSI_{name}")) for name in _DSSI_COUNTS]
     if any(count is None for count in counts):
         return
     # The DSID record, and the DSPM record when there is one (its scale is mandatory).
-    has_dspm = bool(_whole_number(fields.get("DSPM_CSCL")))
+    has_dspm = bool(whole_number(fields.get("DSPM_CSCL")))
     listed = 1 + int(has_dspm) + sum(count or 0 for count in counts)
     if found - 1 < listed:
         raise ChartError(
@@ -200,8 +201,9 @@ def _check_updates_applied(
 _DEPTH_UNITS = {1: "metres", 2: "fathoms and feet", 3: "feet", 4: "fathoms and fractions"}
 
 
-def _check_depth_unit(path: Path, duni: Any) -> None:
-    unit = _whole_number(duni)
+def check_depth_unit(path: Path, duni: Any) -> None:
+    """A ``ChartError`` unless the cell's depth unit (DSPM DUNI) is metres or not given."""
+    unit = whole_number(duni)
     if unit is not None and unit != 1:
         raise ChartError(
             f"{path}: the cell gives its depths in {_DEPTH_UNITS.get(unit, f'unit {unit}')} "

@@ -33,7 +33,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ParameterError
 from ..units import wrap_deg
-from .channels import Channels, _line_angle_deg
+from .channels import Channels, line_angle_deg
 
 
 class ChannelRelation(StrEnum):
@@ -109,7 +109,7 @@ def channel_facts(
     channel = channels.channel_at(north, east)
     inside = channel >= 0
     axis = channels.axis_at(north, east, channel)
-    angle = _line_angle_deg(course, axis.direction_grid_deg)
+    angle = line_angle_deg(course, axis.direction_grid_deg)
     # The axis turned to the way she goes: within 90° of her course (a right angle: as drawn).
     reverse = np.abs(wrap_deg(course - axis.direction_grid_deg + 180.0) - 180.0) > 90.0
     sense = np.where(reverse, -1.0, 1.0)

@@ -25,9 +25,9 @@ import shapely
 from numpy.typing import NDArray
 
 from ..errors import ChartError
-from .gdal_layers import S57_OPEN_OPTIONS, _list_layers, _read_layer
-from .read import S57_SUFFIXES, _to_wgs84
-from .s57_classes import _CHANNEL_CLASS_BY_CODE, CHANNEL_CLASSES
+from .gdal_layers import S57_OPEN_OPTIONS, list_layers, read_layer
+from .read import S57_SUFFIXES, to_wgs84
+from .s57_classes import CHANNEL_CLASS_BY_CODE, CHANNEL_CLASSES
 
 # S-57 attributes read as numbers: (column, what it is, for the error message).
 _NUMERIC = (
@@ -41,7 +41,7 @@ _NUMERIC = (
 
 
 @dataclass(frozen=True)
-class _ChannelFeatures:
+class ChannelFeatures:
     """One file's routeing objects in WGS84 (x lon, y lat), before projection."""
 
     path: Path
@@ -52,30 +52,30 @@ class _ChannelFeatures:
     numbers: Mapping[str, NDArray[np.float64]]  # _NUMERIC's columns, NaN where not charted
 
 
-def _read_channel_features(path: Path) -> _ChannelFeatures:
+def read_channel_features(path: Path) -> ChannelFeatures:
     """The routeing objects of one chart file; a ``ChartError`` names the file, layer and
     value that cannot be read."""
     path = Path(path)
     s57 = path.suffix.lower() in S57_SUFFIXES
     parts = []
-    for layer in _list_layers(path):
+    for layer in list_layers(path):
         if s57 and layer not in CHANNEL_CLASSES:
             continue
         if not s57 and layer.upper() == "DSID":
             continue
-        meta, geometries = _read_layer(path, layer, **(S57_OPEN_OPTIONS if s57 else {}))
+        meta, geometries = read_layer(path, layer, **(S57_OPEN_OPTIONS if s57 else {}))
         classes = _classes(layer, meta["columns"], len(geometries))
         if not (classes != None).any():  # noqa: E711
             continue
         if not s57:
-            geometries = _to_wgs84(geometries, meta["crs"], path)
+            geometries = to_wgs84(geometries, meta["crs"], path)
         parts.append(_layer_part(path, layer, geometries, classes, meta["columns"]))
     if not parts:
         empty = np.empty(0, dtype=object)
-        return _ChannelFeatures(
+        return ChannelFeatures(
             path, empty, empty, empty, empty, {c: np.empty(0) for c, _ in _NUMERIC}
         )
-    return _ChannelFeatures(
+    return ChannelFeatures(
         path,
         np.concatenate([p.geometries for p in parts]),
         np.concatenate([p.object_class for p in parts]),
@@ -100,7 +100,7 @@ def _channel_class(value: Any) -> str | None:
         return None
     text = str(value).strip().upper()
     if text.isdigit():
-        return _CHANNEL_CLASS_BY_CODE.get(int(text))
+        return CHANNEL_CLASS_BY_CODE.get(int(text))
     return text if text in CHANNEL_CLASSES else None
 
 
@@ -110,7 +110,7 @@ def _layer_part(
     geometries: NDArray[np.object_],
     classes: NDArray[np.object_],
     columns: Mapping[str, Any],
-) -> _ChannelFeatures:
+) -> ChannelFeatures:
     """The routeing features of one layer, without those GDAL gave no geometry."""
     keep = (classes != None) & ~shapely.is_missing(geometries)  # noqa: E711
     numbers = {
@@ -121,7 +121,7 @@ def _layer_part(
     name = np.asarray(
         [_text(v) for v in names] if names is not None else [None] * len(geometries), dtype=object
     )
-    return _ChannelFeatures(
+    return ChannelFeatures(
         path,
         geometries[keep],
         classes[keep],

@@ -11,7 +11,7 @@ are true, as charted.
 
 Precedence: where charts overlap, a channel object of a file counts only inside the part of
 the coverage that file decides for the depth areas (``Chart.coverage_by_chart``, ranked by
-``sources._by_detail``: navigational purpose, then compilation scale, then the order
+``sources.by_detail``: navigational purpose, then compilation scale, then the order
 given); the same object charted in a coarser cell is cut away there. Within that, a position
 lying in several channel areas is in the first of them by kind — TSS lane, separation zone,
 deep-water route, fairway, dredged area (the dredged quarters of a fairway lie inside it) —
@@ -42,10 +42,10 @@ from ..errors import ChartError, ParameterError
 from ..geo import LocalFrame
 from ..units import wrap_deg
 from .channel_axis import centreline, orient_axis
-from .channel_read import _ChannelFeatures, _read_channel_features
-from .gdal_layers import _first_line
-from .s57_classes import _POLYGONAL, AREA_CHANNEL_KINDS, CHANNEL_CLASSES, ChannelKind
-from .sources import _project, _same_dimension
+from .channel_read import ChannelFeatures, read_channel_features
+from .gdal_layers import first_line
+from .s57_classes import AREA_CHANNEL_KINDS, CHANNEL_CLASSES, POLYGONAL, ChannelKind
+from .sources import project, same_dimension
 from .water import Chart
 
 # A track runs along an area channel when its direction stays within this of the area's
@@ -164,7 +164,7 @@ def make_channel(
     area = kind in AREA_CHANNEL_KINDS
     parts = shapely.get_parts(geometry)
     parts = parts[
-        np.isin(shapely.get_type_id(parts), _POLYGONAL if area else _LINE_TYPES)
+        np.isin(shapely.get_type_id(parts), POLYGONAL if area else _LINE_TYPES)
         & ~shapely.is_empty(parts)
     ]
     if len(parts) == 0:
@@ -294,6 +294,22 @@ class Channels:
 
     def __getitem__(self, index: int) -> Channel:
         return self.items[index]
+
+    @property
+    def reach_m(self) -> float:
+        """The longest extent of any channel (the diagonal of its bounds, and a metre): a
+        section that long either side of a position crosses the channel areas it is in."""
+        return float(self._reach_m.max(initial=1.0))
+
+    def areas_across(self, lines: NDArray[np.object_]) -> NDArray[np.object_]:
+        """For each line, the channel areas it meets joined into one geometry (empty where
+        it meets none): side by side, they are one channel to be confined to."""
+        line_index, area_rank = self._tree.query(lines, predicate="intersects")
+        joined = np.asarray(shapely.from_wkt(["POLYGON EMPTY"] * len(lines)), dtype=object)
+        geometries = np.asarray([self.items[i].geometry for i in self._areas], dtype=object)
+        for line in np.unique(line_index).tolist():
+            joined[line] = shapely.union_all(geometries[area_rank[line_index == line]])
+        return joined
 
     def labels(self, index: ArrayLike) -> list[str | None]:
         """The label of each indexed channel, None for -1."""
@@ -443,6 +459,27 @@ class Channels:
         return self._water[key]
 
 
+def section_lines(
+    centre_xy: NDArray[np.float64],
+    right_unit: NDArray[np.float64],
+    reach_m: tuple[NDArray[np.float64], NDArray[np.float64]],
+) -> NDArray[np.object_]:
+    """For each point, the line square to its direction from ``reach_m[0][i]`` on its left
+    to ``reach_m[1][i]`` on its right (``section_extents``)."""
+    return np.asarray(
+        shapely.linestrings(
+            np.stack(
+                [
+                    centre_xy - reach_m[0][:, None] * right_unit,
+                    centre_xy + reach_m[1][:, None] * right_unit,
+                ],
+                axis=1,
+            )
+        ),
+        dtype=object,
+    )
+
+
 def section_extents(
     centre_xy: NDArray[np.float64],
     right_unit: NDArray[np.float64],
@@ -457,15 +494,7 @@ def section_extents(
     left, right = np.full(len(centre_xy), np.nan), np.full(len(centre_xy), np.nan)
     if len(centre_xy) == 0:
         return left, right
-    lines = shapely.linestrings(
-        np.stack(
-            [
-                centre_xy - reach_m[0][:, None] * right_unit,
-                centre_xy + reach_m[1][:, None] * right_unit,
-            ],
-            axis=1,
-        )
-    )
+    lines = section_lines(centre_xy, right_unit, reach_m)
     pieces, owner = shapely.get_parts(
         shapely.line_merge(shapely.intersection(lines, areas)), return_index=True
     )
@@ -555,30 +584,30 @@ def _read_channels(chart: Chart) -> Channels:
     items: list[Channel] = []
     several = len(chart.detail_order) > 1
     for rank, path in enumerate(chart.detail_order):
-        features = _read_channel_features(path)
+        features = read_channel_features(path)
         if len(features.geometries) == 0:
             continue
         geometries = _projected(features, chart.frame)
         if several:
             own = chart.coverage_by_chart[rank]
-            geometries = _same_dimension(shapely.intersection(geometries, own), geometries)
+            geometries = same_dimension(shapely.intersection(geometries, own), geometries)
         items.extend(_channels_of(features, geometries, chart.frame))
     channels = Channels(chart.frame, tuple(items), chart)
     return Channels(chart.frame, _with_tracks(channels), chart)
 
 
-def _projected(features: _ChannelFeatures, frame: LocalFrame) -> Any:
+def _projected(features: ChannelFeatures, frame: LocalFrame) -> Any:
     try:
-        return _project(features.geometries, frame)
+        return project(features.geometries, frame)
     except shapely.errors.GEOSException as exc:
         raise ChartError(
-            f"{features.path}: a channel's geometry cannot be used ({_first_line(exc)}); fix "
+            f"{features.path}: a channel's geometry cannot be used ({first_line(exc)}); fix "
             "its rings or lines (lon/lat in degrees)"
         ) from None
 
 
 def _channels_of(
-    features: _ChannelFeatures, geometries: NDArray[np.object_], frame: LocalFrame
+    features: ChannelFeatures, geometries: NDArray[np.object_], frame: LocalFrame
 ) -> list[Channel]:
     numbers = features.numbers
     channels = []
@@ -654,11 +683,11 @@ def _median_angle_deg(channels: Channels, index: int, inside: Any, step_m: float
         line_deg = np.degrees(np.arctan2(chord[:, 0], chord[:, 1]))
         xy = shapely.get_coordinates(shapely.line_interpolate_point(part, at))
         axis_deg = channels.axis_at(xy[:, 1], xy[:, 0], index).direction_grid_deg
-        angles.append(_line_angle_deg(line_deg, axis_deg))
+        angles.append(line_angle_deg(line_deg, axis_deg))
     return float(np.nanmedian(np.concatenate(angles))) if angles else 90.0
 
 
-def _line_angle_deg(a_deg: ArrayLike, b_deg: ArrayLike) -> NDArray[np.float64]:
+def line_angle_deg(a_deg: ArrayLike, b_deg: ArrayLike) -> NDArray[np.float64]:
     """The angle between two undirected lines of these directions, 0–90°."""
     difference = np.abs(wrap_deg(np.asarray(a_deg, dtype=float) - np.asarray(b_deg, dtype=float)))
     difference = np.minimum(difference, 360.0 - difference)

@@ -3,7 +3,7 @@
 The reader (``read``) lists and reads the layers of every chart file (S-57 cell, GeoJSON,
 GeoPackage) here, an S-57 cell with the S57 driver's open options ``S57_OPEN_OPTIONS``
 (``read`` says which and why), which the cell checks (``cells``) use for its DSID record too.
-GDAL's warnings are kept off stderr (``_gdal_quiet``), and what it cannot read is one
+GDAL's warnings are kept off stderr (``gdal_quiet``), and what it cannot read is one
 ``ChartError`` that names the file, and the layer and feature where it can.
 """
 
@@ -27,7 +27,7 @@ S57_OPEN_OPTIONS = {"UPDATES": "APPLY", "SPLIT_MULTIPOINT": "ON", "ADD_SOUNDG_DE
 
 
 @contextmanager
-def _gdal_quiet() -> Iterator[None]:
+def gdal_quiet() -> Iterator[None]:
     """GDAL's warnings (pyogrio passes them on as ``RuntimeWarning``) kept off stderr: a file
     GDAL cannot read is one ``ChartError``, and what it can read needs no remark."""
     with warnings.catch_warnings():
@@ -35,9 +35,10 @@ def _gdal_quiet() -> Iterator[None]:
         yield
 
 
-def _read_layer(path: Path, layer: str | int, **options: str) -> tuple[dict[str, Any], Any]:
+def read_layer(path: Path, layer: str | int, **options: str) -> tuple[dict[str, Any], Any]:
+    """One layer's CRS and attribute columns, and its geometries; a ``ChartError`` names it."""
     try:
-        with _gdal_quiet():  # and shapely's about NaN vertices: _check_finite names them
+        with gdal_quiet():  # and shapely's about NaN vertices: _check_finite names them
             meta, _, wkb, field_data = pyogrio.raw.read(path, layer=layer, **options)
             geometries = shapely.from_wkb(wkb) if wkb is not None else np.empty(0, dtype=object)
     except (
@@ -49,7 +50,7 @@ def _read_layer(path: Path, layer: str | int, **options: str) -> tuple[dict[str,
         shapely.errors.GEOSException,
     ) as exc:
         raise ChartError(
-            f"{path}: cannot read layer {layer} ({_first_line(exc)}); give an S-57 .000, "
+            f"{path}: cannot read layer {layer} ({first_line(exc)}); give an S-57 .000, "
             "GeoJSON or GeoPackage chart"
         ) from None
     columns = dict(zip(meta["fields"], field_data, strict=True))
@@ -78,16 +79,18 @@ def _check_finite(
     )
 
 
-def _first_line(exc: BaseException) -> str:
+def first_line(exc: BaseException) -> str:
+    """The first line of an exception's message (GDAL's run to several), for an error."""
     return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
 
 
-def _list_layers(path: Path) -> list[str]:
+def list_layers(path: Path) -> list[str]:
+    """The names of a chart file's layers; a ``ChartError`` where GDAL cannot open it."""
     try:
-        with _gdal_quiet():
+        with gdal_quiet():
             return [str(name) for name, _ in pyogrio.list_layers(path)]
     except (DataSourceError, DataLayerError, RuntimeError) as exc:
         raise ChartError(
-            f"{path}: not a chart GDAL can open ({_first_line(exc)}); give an S-57 .000, "
+            f"{path}: not a chart GDAL can open ({first_line(exc)}); give an S-57 .000, "
             "GeoJSON or GeoPackage chart"
         ) from None

@@ -12,7 +12,7 @@ Sources
   routeing classes (``FAIRWY``, ``TSSLPT`` …, ``s57_classes.CHANNEL_CLASSES``) are not part of
   the water; ``channels`` reads them from the same files.
 
-Each file is read on its own into ``_Features``: its geometries in WGS84 longitude/latitude
+Each file is read on its own into ``Features``: its geometries in WGS84 longitude/latitude
 with their object class and depths, its coverage and its level of detail, or a ``ChartError``
 naming the file. Nothing here knows of the other charts or of the run's frame (``sources``).
 """
@@ -33,14 +33,14 @@ from pyproj import CRS, Transformer
 from pyproj.exceptions import CRSError
 
 from ..errors import ChartError
-from .cells import _check_depth_unit, _dsid_fields, _whole_number, cell_purpose
-from .gdal_layers import S57_OPEN_OPTIONS, _list_layers, _read_layer
+from .cells import cell_purpose, check_depth_unit, dsid_fields, whole_number
+from .gdal_layers import S57_OPEN_OPTIONS, list_layers, read_layer
 from .s57_classes import (
-    _ACRONYM_BY_CODE,
-    _BLOCKING_CLASSES,
-    _OBJECT_CLASSES,
-    _POLYGONAL,
+    ACRONYM_BY_CODE,
+    BLOCKING_CLASSES,
     CHANNEL_CLASSES,
+    OBJECT_CLASSES,
+    POLYGONAL,
 )
 
 S57_SUFFIXES = (".000",)
@@ -48,7 +48,7 @@ VECTOR_SUFFIXES = (".geojson", ".json", ".gpkg")
 
 
 @dataclass(frozen=True)
-class _Features:
+class Features:
     """One file's features in WGS84 (x lon, y lat), before projection."""
 
     path: Path
@@ -95,24 +95,24 @@ def _object_class(value: Any, path: Path) -> str | None:
         return None
     text = str(value).strip().upper()
     if text.isdigit():
-        return _ACRONYM_BY_CODE.get(int(text))
-    return text if text in _OBJECT_CLASSES else None
+        return ACRONYM_BY_CODE.get(int(text))
+    return text if text in OBJECT_CLASSES else None
 
 
-def _read_s57(path: Path) -> _Features:
-    layers = set(_list_layers(path))
+def _read_s57(path: Path) -> Features:
+    layers = set(list_layers(path))
     parts: list[tuple[NDArray[np.object_], str, Mapping[str, Any]]] = []
-    for name in _OBJECT_CLASSES:
+    for name in OBJECT_CLASSES:
         if name in layers:
-            meta, geometries = _read_layer(path, name, **S57_OPEN_OPTIONS)
+            meta, geometries = read_layer(path, name, **S57_OPEN_OPTIONS)
             parts.append((geometries, name, meta["columns"]))
     features = _assemble(path, parts)
     coverage = None
     if "M_COVR" in layers:
-        meta, geometries = _read_layer(path, "M_COVR", **S57_OPEN_OPTIONS)
+        meta, geometries = read_layer(path, "M_COVR", **S57_OPEN_OPTIONS)
         coverage = _coverage_of(geometries, meta["columns"].get("CATCOV"))
-    dsid = _dsid_fields(path)
-    scale = _whole_number(dsid.get("DSPM_CSCL"))
+    dsid = dsid_fields(path)
+    scale = whole_number(dsid.get("DSPM_CSCL"))
     return dataclasses.replace(
         features,
         coverage=coverage,
@@ -124,7 +124,7 @@ def _read_s57(path: Path) -> _Features:
 def _coverage_of(geometries: NDArray[np.object_], catcov: Any) -> Any:
     """The union of the CATCOV 1 ("coverage available") areas less the CATCOV 2 ones; None
     when there are none."""
-    polygonal = np.isin(shapely.get_type_id(geometries), _POLYGONAL)
+    polygonal = np.isin(shapely.get_type_id(geometries), POLYGONAL)
     codes = np.ones(len(geometries)) if catcov is None else _numeric(catcov, Path(), "CATCOV")
     codes = np.where(np.isnan(codes), 1.0, codes)
     covered = geometries[polygonal & (codes == 1.0)]
@@ -134,7 +134,7 @@ def _coverage_of(geometries: NDArray[np.object_], catcov: Any) -> Any:
     return shapely.difference(shapely.union_all(covered), shapely.union_all(uncovered))
 
 
-def _read_vector(path: Path) -> _Features:
+def _read_vector(path: Path) -> Features:
     """A GeoJSON/GeoPackage chart with S-57 attribute names. Features of class M_COVR (with
     CATCOV) give its coverage, and their INTU (navigational purpose) and CSCL (compilation
     scale) its level of detail, as a cell's DSID would.
@@ -146,13 +146,13 @@ def _read_vector(path: Path) -> _Features:
     parts: list[tuple[NDArray[np.object_], str | NDArray[np.object_], Mapping[str, Any]]] = []
     coverage_parts: list[Any] = []
     detail: dict[str, float] = {}
-    for layer in _list_layers(path):
-        meta, geometries = _read_layer(path, layer)
+    for layer in list_layers(path):
+        meta, geometries = read_layer(path, layer)
         columns = meta["columns"]
         if layer.upper() == "DSID":
             _dsid_detail(columns, detail)
             duni = columns.get("DSPM_DUNI")
-            _check_depth_unit(path, duni[0] if duni is not None and len(duni) else None)
+            check_depth_unit(path, duni[0] if duni is not None and len(duni) else None)
             continue
         if len(geometries) == 0:
             continue
@@ -172,7 +172,7 @@ def _read_vector(path: Path) -> _Features:
                 "GeoPackage chart needs OBJL (S-57 object class, e.g. DEPARE) and DRVAL1 "
                 "(shallowest depth, m)"
             )
-        geometries = _to_wgs84(geometries, meta["crs"], path)
+        geometries = to_wgs84(geometries, meta["crs"], path)
         parts.append((geometries, classes, columns))
         is_coverage = np.asarray(
             [str(v).strip().upper() in ("M_COVR", "302") for v in objl], dtype=bool
@@ -205,19 +205,19 @@ def _is_class_name(layer: str) -> bool:
     """A layer named after an S-57 object class the charts are read for (its features take
     that class); routeing layers (FAIRWY …) are left to ``channels``."""
     name = layer.upper()
-    return name in _OBJECT_CLASSES or name in CHANNEL_CLASSES or name == "M_COVR"
+    return name in OBJECT_CLASSES or name in CHANNEL_CLASSES or name == "M_COVR"
 
 
 def _dsid_detail(columns: Mapping[str, Any], detail: dict[str, float]) -> None:
     """Navigational purpose and compilation scale from a DSID table (S-57 field names)."""
     for name, key in (("DSID_INTU", "purpose"), ("DSPM_CSCL", "scale")):
         values = columns.get(name)
-        number = _whole_number(values[0]) if values is not None and len(values) else None
+        number = whole_number(values[0]) if values is not None and len(values) else None
         if number:
             detail[key] = float(number)
 
 
-def _to_wgs84(geometries: NDArray[np.object_], crs: str | None, path: Path) -> Any:
+def to_wgs84(geometries: NDArray[np.object_], crs: str | None, path: Path) -> Any:
     """The geometries in WGS84 longitude/latitude; coordinates off the Earth are an error
     naming the file (a projected chart without its CRS, say)."""
     return _on_earth(_transformed(geometries, crs, path), path)
@@ -255,7 +255,7 @@ def _transformed(geometries: NDArray[np.object_], crs: str | None, path: Path) -
 def _assemble(
     path: Path,
     parts: Sequence[tuple[NDArray[np.object_], str | NDArray[np.object_], Mapping[str, Any]]],
-) -> _Features:
+) -> Features:
     geometries: list[NDArray[np.object_]] = []
     classes: list[NDArray[np.object_]] = []
     drval1: list[NDArray[np.float64]] = []
@@ -271,8 +271,8 @@ def _assemble(
             values = columns.get(column)
             out.append(np.full(n, np.nan) if values is None else _numeric(values, path, column))
     if not geometries:
-        return _Features(path, *(np.empty(0, dtype=object),) * 2, *(np.empty(0),) * 3)
-    features = _Features(
+        return Features(path, *(np.empty(0, dtype=object),) * 2, *(np.empty(0),) * 3)
+    features = Features(
         path,
         np.concatenate(geometries),
         np.concatenate(classes),
@@ -282,7 +282,7 @@ def _assemble(
     )
     missing = shapely.is_missing(features.geometries)
     # Land or a hazard without a geometry would leave water where there is none.
-    blocking = missing & np.isin(features.object_class, _BLOCKING_CLASSES)
+    blocking = missing & np.isin(features.object_class, BLOCKING_CLASSES)
     if blocking.any():
         first = features.object_class[blocking][0]
         raise ChartError(
@@ -291,7 +291,7 @@ def _assemble(
             "in the file's coordinates), or leave the feature out"
         )
     keep = ~missing & (features.object_class != None)  # noqa: E711
-    return _Features(
+    return Features(
         path,
         features.geometries[keep],
         features.object_class[keep],
@@ -301,7 +301,8 @@ def _assemble(
     )
 
 
-def _read_features(path: Path) -> _Features:
+def read_features(path: Path) -> Features:
+    """One chart file's features in WGS84; a ``ChartError`` where it is no usable chart."""
     path = Path(path)
     if path.is_dir():
         raise ChartError(f"{path}: a directory, not a chart file; give the chart file itself")
@@ -318,7 +319,7 @@ def _read_features(path: Path) -> _Features:
             "(.000), a GeoJSON (.geojson) or a GeoPackage (.gpkg)"
         )
     depth = np.isin(features.object_class, ["DEPARE", "DRGARE"])
-    polygonal = np.isin(shapely.get_type_id(features.geometries), _POLYGONAL)
+    polygonal = np.isin(shapely.get_type_id(features.geometries), POLYGONAL)
     if not (depth & polygonal).any():
         raise ChartError(
             f"{path}: the chart has no depth areas (DEPARE or DRGARE polygons); give a chart "

@@ -4,7 +4,7 @@ Object classes used: DEPARE and DRGARE (dredged areas count as depth areas), LND
 PONTON, HULKES, FLODOC and DRYDOC areas (structures that cut holes in the depth areas; they
 are treated like land), and OBSTRN, WRECKS and UWTROC as point hazards.
 
-One table (``_OBJECT_CLASSES``) serves the reader (``read``), which keeps the features of
+One table (``OBJECT_CLASSES``) serves the reader (``read``), which keeps the features of
 these classes only, and the chart (``sources``, ``water``), which sorts them by role into
 depth areas, land and hazards: a class is added in one place.
 
@@ -33,7 +33,7 @@ class ChartLayer(StrEnum):
 
 
 # S-57 object class acronym → (numeric code, role).
-_OBJECT_CLASSES: dict[str, tuple[int, ChartLayer]] = {
+OBJECT_CLASSES: dict[str, tuple[int, ChartLayer]] = {
     "DEPARE": (42, ChartLayer.DEPARE),
     "DRGARE": (46, ChartLayer.DRGARE),
     "LNDARE": (71, ChartLayer.LNDARE),
@@ -82,11 +82,11 @@ AREA_CHANNEL_KINDS = frozenset(
         ChannelKind.TSS_ZONE,
     }
 )
-_CHANNEL_CLASS_BY_CODE = {code: name for name, (code, _) in CHANNEL_CLASSES.items()}
-_ACRONYM_BY_CODE = {code: name for name, (code, _) in _OBJECT_CLASSES.items()}
-_BLOCKING_CLASSES = [
+CHANNEL_CLASS_BY_CODE = {code: name for name, (code, _) in CHANNEL_CLASSES.items()}
+ACRONYM_BY_CODE = {code: name for name, (code, _) in OBJECT_CLASSES.items()}
+BLOCKING_CLASSES = [
     name
-    for name, (_, role) in _OBJECT_CLASSES.items()
+    for name, (_, role) in OBJECT_CLASSES.items()
     if role in (ChartLayer.LNDARE, ChartLayer.HAZARD)
 ]
-_POLYGONAL = (shapely.GeometryType.POLYGON, shapely.GeometryType.MULTIPOLYGON)
+POLYGONAL = (shapely.GeometryType.POLYGON, shapely.GeometryType.MULTIPOLYGON)

@@ -5,7 +5,7 @@ less those with CATCOV 2 (an S-57 cell's ``M_COVR`` layer, or features of class 
 GeoJSON/GeoPackage); a chart without them covers the union of its depth areas, land and
 structures.
 
-Several charts are ranked most detailed first (``_by_detail``): the higher navigational
+Several charts are ranked most detailed first (``by_detail``): the higher navigational
 purpose (DSID INTU, else the digit in an S-57 cell name's third character; for GeoJSON/
 GeoPackage an ``INTU`` property on its M_COVR features or a DSID table), then the larger
 compilation scale (DSPM CSCL; ``CSCL`` on M_COVR), then the order given. Each chart decides
@@ -13,7 +13,7 @@ only where no more detailed one covers: its features are clipped to its coverage
 
 Here the files are read (``read``, ``cells``) into a ``ChartSource``, and each file's features
 are projected into the run's frame and clipped to the part of the coverage it decides
-(``_claimed_by_detail``); ``water`` merges what is left into one ``Chart``.
+(``claimed_by_detail``); ``water`` merges what is left into one ``Chart``.
 """
 
 from __future__ import annotations
@@ -30,9 +30,9 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import ChartError
 from ..geo import LocalFrame
 from .cells import CellInfo, s57_cell_info
-from .gdal_layers import _first_line
-from .read import S57_SUFFIXES, _Features, _read_features
-from .s57_classes import _OBJECT_CLASSES, _POLYGONAL, ChartLayer
+from .gdal_layers import first_line
+from .read import S57_SUFFIXES, Features, read_features
+from .s57_classes import OBJECT_CLASSES, POLYGONAL, ChartLayer
 
 
 @dataclass(frozen=True)
@@ -41,7 +41,7 @@ class ChartSource:
     ``cells`` describes the S-57 cells among them."""
 
     paths: tuple[Path, ...]
-    features: tuple[_Features, ...]
+    features: tuple[Features, ...]
     cells: tuple[CellInfo, ...] = ()
 
     @property
@@ -86,17 +86,19 @@ def read_charts(paths: Sequence[Path], accept_gaps: bool = False) -> ChartSource
         for p in files
         if p.suffix.lower() in S57_SUFFIXES and p.is_file()
     )
-    return ChartSource(paths=files, features=tuple(_read_features(p) for p in files), cells=cells)
+    return ChartSource(paths=files, features=tuple(read_features(p) for p in files), cells=cells)
 
 
-def _by_detail(features: Sequence[_Features]) -> list[_Features]:
+def by_detail(features: Sequence[Features]) -> list[Features]:
     """Most detailed first: higher navigational purpose, then larger compilation scale
     (smaller denominator), then the order given."""
     order = sorted(range(len(features)), key=lambda i: (-features[i].purpose, features[i].scale, i))
     return [features[i] for i in order]
 
 
-def _project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
+def project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
+    """WGS84 geometries in ``frame`` (east, north in metres), invalid ones repaired."""
+
     def lonlat_to_east_north(xy: NDArray[np.float64]) -> NDArray[np.float64]:
         north_m, east_m = frame.to_local(xy[:, 1], xy[:, 0])
         return np.column_stack([east_m, north_m])
@@ -105,37 +107,37 @@ def _project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
     invalid = ~shapely.is_valid(projected)
     if invalid.any():
         # A ring with a spike is repaired into its area and a line: keep the area.
-        projected[invalid] = _same_dimension(
+        projected[invalid] = same_dimension(
             shapely.make_valid(projected[invalid]), projected[invalid]
         )
     return projected
 
 
-def _project_file(features: _Features, frame: LocalFrame) -> Any:
+def _project_file(features: Features, frame: LocalFrame) -> Any:
     """A file's features in the frame; a geometry GEOS cannot repair names the file."""
     try:
-        return _project(features.geometries, frame)
+        return project(features.geometries, frame)
     except shapely.errors.GEOSException as exc:
         raise ChartError(
-            f"{features.path}: a feature's geometry cannot be used ({_first_line(exc)}); fix "
+            f"{features.path}: a feature's geometry cannot be used ({first_line(exc)}); fix "
             "its rings (closed, at least three distinct vertices, lon/lat in degrees)"
         ) from None
 
 
-def _file_coverage(features: _Features, geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
+def _file_coverage(features: Features, geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
     """A file's coverage in the frame: its M_COVR, else the union of its areas
     (``geometries``: its features in the frame)."""
     if features.coverage is not None:
-        return _project(np.array([features.coverage], dtype=object), frame)[0]
-    role = np.asarray([_OBJECT_CLASSES[c][1] for c in features.object_class], dtype=object)
+        return project(np.array([features.coverage], dtype=object), frame)[0]
+    role = np.asarray([OBJECT_CLASSES[c][1] for c in features.object_class], dtype=object)
     areal = np.isin(role, [ChartLayer.DEPARE, ChartLayer.DRGARE, ChartLayer.LNDARE]) & np.isin(
-        shapely.get_type_id(geometries), _POLYGONAL
+        shapely.get_type_id(geometries), POLYGONAL
     )
     return shapely.union_all(geometries[areal])
 
 
-def _claimed_by_detail(
-    features: Sequence[_Features], frame: LocalFrame
+def claimed_by_detail(
+    features: Sequence[Features], frame: LocalFrame
 ) -> tuple[list[NDArray[np.object_]], list[Any]]:
     """Each file's projected geometries, cut to where no more detailed file has coverage (a
     coarse cell decides only outside the detailed one), and each file's coverage left."""
@@ -147,14 +149,14 @@ def _claimed_by_detail(
     kept_geometries, kept_coverages = [], []
     for geometries, coverage in zip(projected, coverages, strict=True):
         own = shapely.difference(coverage, claimed)
-        clipped = _same_dimension(shapely.intersection(geometries, own), geometries)
+        clipped = same_dimension(shapely.intersection(geometries, own), geometries)
         kept_geometries.append(clipped)
         kept_coverages.append(own)
         claimed = shapely.union(claimed, coverage)
     return kept_geometries, kept_coverages
 
 
-def _same_dimension(clipped: NDArray[np.object_], original: NDArray[np.object_]) -> Any:
+def same_dimension(clipped: NDArray[np.object_], original: NDArray[np.object_]) -> Any:
     """``clipped`` with the parts of a lower dimension than the feature's dropped.
 
     GEOS may return a polygon clipped along an edge of the clip as a geometry collection (the

@@ -34,8 +34,8 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import ChartError, ParameterError
 from ..geo import FRAME_REACH_M, LocalFrame
 from .cells import CellInfo
-from .s57_classes import _OBJECT_CLASSES, _POLYGONAL, ChartLayer
-from .sources import ChartSource, _by_detail, _claimed_by_detail, read_charts
+from .s57_classes import OBJECT_CLASSES, POLYGONAL, ChartLayer
+from .sources import ChartSource, by_detail, claimed_by_detail, read_charts
 
 HAZARD_RADIUS_M = 10.0
 # Depth areas that should meet often leave slivers of gap between them (or of land filling the
@@ -240,14 +240,14 @@ def _check_within_reach(source: ChartSource, frame: LocalFrame) -> None:
 def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Chart:
     """Merge charts already read and project them into ``frame`` (default: their extent).
 
-    Where charts overlap, the most detailed one decides (``_by_detail``): a union of the
+    Where charts overlap, the most detailed one decides (``by_detail``): a union of the
     deep areas of two cells would take the deeper of two disagreeing soundings.
     """
-    features = _by_detail(source.features)
+    features = by_detail(source.features)
     if frame is None:
         frame = LocalFrame.centred_on(*source.bounds_wgs84())
     _check_within_reach(source, frame)
-    per_file, coverages = _claimed_by_detail(features, frame)
+    per_file, coverages = claimed_by_detail(features, frame)
     geometries = np.concatenate(per_file)
     object_class = np.concatenate([f.object_class for f in features])
     drval1 = np.concatenate([f.drval1_m for f in features])
@@ -260,8 +260,8 @@ def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Char
     geometries, object_class = geometries[present], object_class[present]
     drval1, drval2, valsou = drval1[present], drval2[present], valsou[present]
     chart_index = chart_index[present]
-    role = np.asarray([_OBJECT_CLASSES[c][1] for c in object_class], dtype=object)
-    polygonal = np.isin(shapely.get_type_id(geometries), _POLYGONAL)
+    role = np.asarray([OBJECT_CLASSES[c][1] for c in object_class], dtype=object)
+    polygonal = np.isin(shapely.get_type_id(geometries), POLYGONAL)
 
     depth = np.isin(role, [ChartLayer.DEPARE, ChartLayer.DRGARE]) & polygonal
     if not depth.any():
@@ -296,7 +296,7 @@ def project_charts(source: ChartSource, frame: LocalFrame | None = None) -> Char
         detail_order=tuple(f.path for f in features),
         coverage_by_chart=tuple(coverages),
         depth_chart=chart_index[depth],
-        layer_counts={name: counts[name] for name in _OBJECT_CLASSES if name in counts},
+        layer_counts={name: counts[name] for name in OBJECT_CLASSES if name in counts},
         hazard_areas=hazard_areas,
         hazard_depth_m=hazard_depth,
     )

@@ -21,10 +21,8 @@ at each):
   navigable width (``colregs9 chart --draught``).
 
 Rule 9(b)'s "a vessel which can safely navigate only within a narrow channel or fairway",
-at the trigger, for a vessel proceeding along a channel (``confined_to_channel``): her
-draught confines her when the water navigable for it (plus her UKC) reaches less than
-``channel_confined_within_lengths`` of her lengths beyond the channel's limit on both hands
-(``charts.channel_confinement``). ``rule9.decide_pair`` takes it as d3 beside the estimator.
+for a vessel proceeding along a channel at the trigger: ``confinement.py`` judges it over
+the same rows; ``rule9.decide_pair`` takes it as d3 beside the estimator.
 
 Rule 10 where a traffic separation scheme is charted (``TSSLPT`` lanes with their
 ``ORIENT``), over the same rows:
@@ -47,15 +45,20 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..charts.channel_confinement import water_beyond_limits
 from ..charts.channel_facts import ChannelFacts, ChannelParams, ChannelRelation, channel_facts
 from ..charts.channels import Channels
 from ..charts.s57_classes import ChannelKind
-from ..charts.water import Chart
 from ..errors import ParameterError
 from ..units import signed_angle_deg, wrap_deg
 from .audit import Fact
-from .vessel_defaults import VesselDimensions
+from .confinement import (
+    NO_CHART,
+    NOT_ALONG,
+    ConfinedToChannel,
+    ConfinementParams,
+    DraughtOnChart,
+    confined_to_channel,
+)
 
 
 @dataclass(frozen=True)
@@ -66,10 +69,8 @@ class ChannelAuditParams:
     when those last ``starboard_side_min_s`` (30 s: a speed span, so that a vessel only
     turning through a channel is not judged on it); rule 10(c): a lane crossed within
     ``lane_crossing_within_deg`` (15°) of a right angle, half the 30° that "along" allows,
-    as "as nearly as practicable" asks more than a course along; confined to a channel by
-    her draught where the water navigable for her reaches less than
-    ``channel_confined_within_lengths`` (1) of her lengths beyond its limits on both hands.
-    ``[replay]`` keys of the same names."""
+    as "as nearly as practicable" asks more than a course along; and the thresholds of
+    ``confinement.ConfinementParams``. ``[replay]`` keys of the same names."""
 
     channel_along_within_deg: float = 30.0
     channel_crossing_from_deg: float = 45.0
@@ -77,6 +78,7 @@ class ChannelAuditParams:
     starboard_side_min_s: float = 30.0
     lane_crossing_within_deg: float = 15.0
     channel_confined_within_lengths: float = 1.0
+    channel_narrow_within_lengths: float = 5.0
 
     def __post_init__(self) -> None:
         if not 0.5 <= self.starboard_side_share <= 1.0:
@@ -93,15 +95,13 @@ class ChannelAuditParams:
                 f"[replay] lane_crossing_within_deg = {self.lane_crossing_within_deg!r}: give "
                 "0 to 45 degrees"
             )
-        if not (
-            np.isfinite(self.channel_confined_within_lengths)
-            and self.channel_confined_within_lengths > 0.0
-        ):
-            raise ParameterError(
-                "[replay] channel_confined_within_lengths = "
-                f"{self.channel_confined_within_lengths!r}: give a number of her lengths > 0"
-            )
-        self.angles()  # the angles are checked there
+        self.angles()  # the angles are checked there, and the confinement's thresholds
+        self.confinement()
+
+    def confinement(self) -> ConfinementParams:
+        return ConfinementParams(
+            self.channel_confined_within_lengths, self.channel_narrow_within_lengths
+        )
 
     def angles(self) -> ChannelParams:
         return ChannelParams(self.channel_along_within_deg, self.channel_crossing_from_deg)
@@ -143,25 +143,6 @@ NO_LANE = LaneConduct(None, None, "in no traffic lane")
 
 
 @dataclass(frozen=True)
-class DraughtOnChart:
-    """What the confinement of a vessel to her channel reads: the chart's depths (None: no
-    chart), her dimensions and the under-keel clearance she keeps."""
-
-    chart: Chart | None
-    dimensions: VesselDimensions
-    ukc_m: float
-
-
-@dataclass(frozen=True)
-class ConfinedToChannel:
-    """Whether her draught confines her to the channel she proceeds along at the trigger
-    (``confined_to_channel``): the fact (None: not along a channel) and its basis."""
-
-    fact: Fact | None
-    basis: str
-
-
-@dataclass(frozen=True)
 class VesselInChannel:
     """One vessel of a pair and the charted channels over the passing."""
 
@@ -169,7 +150,7 @@ class VesselInChannel:
     at_least_separation: ChannelPlace
     keeps_to_starboard_side: StarboardSide
     lane: LaneConduct = NO_LANE
-    confined: ConfinedToChannel = ConfinedToChannel(None, "no chart")
+    confined: ConfinedToChannel = NO_CHART
     # From the trigger to the closest approach: how far the axis of the channel she
     # proceeds along has turned since the trigger (0 where she is not along the one she was
     # along at the trigger), so that a turn that follows a bend is not an action.
@@ -179,7 +160,6 @@ class VesselInChannel:
 NOT_CHARTED = VesselInChannel(
     OUTSIDE, OUTSIDE, StarboardSide(None, "no chart"), LaneConduct(None, None, "no chart")
 )
-NOT_ALONG = "not proceeding along a charted channel"
 
 
 def _place(channels: Channels, facts: ChannelFacts, row: int) -> ChannelPlace:
@@ -297,79 +277,13 @@ def vessel_in_channel(
         confined=confined_to_channel(
             channels,
             facts,
-            (float(rows[f"{prefix}north_m"].iloc[0]), float(rows[f"{prefix}east_m"].iloc[0])),
+            rows[f"{prefix}north_m"].to_numpy(dtype=float),
+            rows[f"{prefix}east_m"].to_numpy(dtype=float),
             draught,
-            params,
+            params.confinement(),
         ),
         bend_deg=channel_bend_deg(facts),
     )
-
-
-def confined_to_channel(
-    channels: Channels,
-    facts: ChannelFacts,
-    position_m: tuple[float, float],
-    draught: DraughtOnChart,
-    params: ChannelAuditParams,
-) -> ConfinedToChannel:
-    """Rule 9(b)'s "can safely navigate only within" the channel, for a vessel at
-    ``position_m`` (north, east) whose ``facts`` row 0 is the trigger: ``true`` when the
-    water navigable for her draught plus her UKC reaches less than
-    ``channel_confined_within_lengths`` of her lengths beyond the channel's limit on both
-    hands (``charts.channel_confinement``), ``false`` when it reaches that far on either;
-    ``insufficient-data`` without a reported draught and length, where her position is not
-    charted navigable for her, or where the water reaches the chart's edge. None when she
-    does not proceed along a channel at the trigger."""
-    if facts.relation[0] != ChannelRelation.ALONG:
-        return ConfinedToChannel(None, NOT_ALONG)
-    label = channels[int(facts.channel[0])].label
-    dimensions, ukc_m = draught.dimensions, draught.ukc_m
-    missing = [
-        name.removesuffix("_m")
-        for name in ("draught_m", "length_m")
-        if name in dimensions.defaulted
-    ]
-    if missing:
-        return ConfinedToChannel(
-            Fact.INSUFFICIENT, f"along {label}; her {' and '.join(missing)} not reported"
-        )
-    if draught.chart is None:
-        return ConfinedToChannel(Fact.INSUFFICIENT, f"along {label}; no depths charted")
-    within_m = params.channel_confined_within_lengths * dimensions.length_m
-    beyond = water_beyond_limits(
-        channels,
-        draught.chart,
-        position_m[0],
-        position_m[1],
-        int(facts.channel[0]),
-        float(facts.axis_grid_deg[0]),
-        dimensions.draught_m,
-        ukc_m,
-        within_m,
-    )
-    port, starboard = float(beyond.port_m[0]), float(beyond.starboard_m[0])
-    water = f"water navigable for her draught {dimensions.draught_m:g} m + UKC {ukc_m:g} m"
-    if not (np.isfinite(port) or np.isfinite(starboard)):
-        return ConfinedToChannel(
-            Fact.INSUFFICIENT,
-            f"along {label}; her position is not in {water} (chart or draught in doubt)",
-        )
-    basis = (
-        f"along {label}; {water} reaches {_room(port, within_m)} beyond its port-hand limit "
-        f"and {_room(starboard, within_m)} beyond its starboard-hand limit (confined under "
-        f"{within_m:.0f} m, {params.channel_confined_within_lengths:g} of her length)"
-    )
-    if port >= within_m or starboard >= within_m:
-        return ConfinedToChannel(Fact.FALSE, basis)
-    if np.isfinite(port) and np.isfinite(starboard):
-        return ConfinedToChannel(Fact.TRUE, basis)
-    return ConfinedToChannel(Fact.INSUFFICIENT, f"{basis}: it reaches the chart's edge")
-
-
-def _room(beyond_m: float, within_m: float) -> str:
-    if not np.isfinite(beyond_m):
-        return "to the chart's edge"
-    return f"{within_m:.0f} m or more" if beyond_m >= within_m else f"{beyond_m:.0f} m"
 
 
 def channel_bend_deg(facts: ChannelFacts) -> np.ndarray:

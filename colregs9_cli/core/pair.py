@@ -51,7 +51,6 @@ from .audit import (
 from .channel_audit import (
     NOT_CHARTED,
     ChannelAuditParams,
-    DraughtOnChart,
     VesselInChannel,
     meeting_along_a_channel,
     vessel_in_channel,
@@ -65,6 +64,7 @@ from .colregs import (
     SituationBasis,
     evaluate_colregs,
 )
+from .confinement import DraughtOnChart
 from .encounters import Encounter, EncounterParams, encounter_series
 from .interactions import (
     Interaction,

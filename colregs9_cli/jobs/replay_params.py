@@ -3,9 +3,9 @@ stages' own parameters.
 
 One table holds every knob of the tracks → encounters → rule 9 chain, so that a query file
 states the replay in one place; each core stage takes only its part (``TrackParams``,
-``EncounterParams``, ``ConductParams``, ``Rule9Params``, ``DimensionDefaults``). Defaults are
-the paper's Table "Simulation parameters" (time step 1 s, TCPA_act 3 min, CPA_req 150 m) and
-docs/design.md §5.
+``EncounterParams``, ``ConductParams``, ``Rule9Params``, ``DimensionDefaults``). A key that
+a stage also has takes that stage's default. Defaults are the paper's Table "Simulation
+parameters" (time step 1 s, TCPA_act 3 min, CPA_req 150 m) and docs/design.md §5.
 
 ``[colregs]`` (sector angles, course source) is ``ColregsParams`` in ``colregs.py``.
 """
@@ -30,7 +30,6 @@ from ..core.rule9 import Rule9Params
 from ..core.tracks import TrackParams
 from ..core.vessel_defaults import DimensionDefaults
 from ..errors import ParameterError
-from ..units import METRES_PER_NAUTICAL_MILE
 
 T = TypeVar("T")
 
@@ -83,46 +82,48 @@ class ReplayParams:
       memory grows with it, the results do not depend on it.
     """
 
-    step_s: float = 1.0
-    max_gap_s: float = 300.0
-    max_speed_kn: float = 50.0
-    min_sog_kn: float = 0.5
-    candidate_range_m: float = 2.0 * METRES_PER_NAUTICAL_MILE
-    tcpa_act_s: float = 180.0
-    cpa_req_m: float = 150.0
+    # A key a stage also has takes the stage's default (tests/test_replay_params.py).
+    step_s: float = TrackParams.step_s
+    max_gap_s: float = TrackParams.max_gap_s
+    max_speed_kn: float = TrackParams.max_speed_kn
+    min_sog_kn: float = TrackParams.min_sog_kn
+    candidate_range_m: float = EncounterParams.candidate_range_m
+    tcpa_act_s: float = EncounterParams.tcpa_act_s
+    cpa_req_m: float = EncounterParams.cpa_req_m
     course_change_deg: float = 15.0
     speed_change_frac: float = 0.25
     speed_change_min_kn: float = 1.0
     course_judged_above_kn: float = 2.0
-    stopped_below_kn: float = 0.5
-    restricted_nav_statuses: frozenset[int] = frozenset({3, 4})
-    reassess_every_s: float = 10.0
-    default_length_m: float | None = None
-    default_breadth_m: float | None = None
-    default_draught_m: float | None = None
+    stopped_below_kn: float = ConductParams.stopped_below_kn
+    restricted_nav_statuses: frozenset[int] = Rule9Params.restricted_nav_statuses
+    reassess_every_s: float = Rule9Params.reassess_every_s
+    default_length_m: float | None = DimensionDefaults.length_m
+    default_breadth_m: float | None = DimensionDefaults.breadth_m
+    default_draught_m: float | None = DimensionDefaults.draught_m
     slab_s: float = 1800.0
-    passing_open_m: float = 100.0
-    passing_open_frac: float = 0.5
-    passing_follow_s: float = 600.0
-    interaction_window_s: float = 120.0
-    speed_span_s: float = 30.0
-    making_way_kn: float = 1.0
-    at_rest_min_s: float = 30.0
-    alongside_margin_m: float = 10.0
-    alongside_min_s: float = 60.0
-    service_margin_m: float = 30.0
-    service_speed_kn: float = 1.0
-    service_min_s: float = 30.0
-    company_min_s: float = 120.0
-    company_course_deg: float = 20.0
-    company_drift_m: float = 30.0
-    company_drift_frac: float = 0.25
-    channel_along_within_deg: float = 30.0
-    channel_crossing_from_deg: float = 45.0
-    starboard_side_share: float = 0.8
-    starboard_side_min_s: float = 30.0
-    lane_crossing_within_deg: float = 15.0
-    channel_confined_within_lengths: float = 1.0
+    passing_open_m: float = PassingParams.open_m
+    passing_open_frac: float = PassingParams.open_frac
+    passing_follow_s: float = PassingParams.follow_s
+    interaction_window_s: float = InteractionParams.interaction_window_s
+    speed_span_s: float = InteractionParams.speed_span_s
+    making_way_kn: float = InteractionParams.making_way_kn
+    at_rest_min_s: float = InteractionParams.at_rest_min_s
+    alongside_margin_m: float = InteractionParams.alongside_margin_m
+    alongside_min_s: float = InteractionParams.alongside_min_s
+    service_margin_m: float = InteractionParams.service_margin_m
+    service_speed_kn: float = InteractionParams.service_speed_kn
+    service_min_s: float = InteractionParams.service_min_s
+    company_min_s: float = InteractionParams.company_min_s
+    company_course_deg: float = InteractionParams.company_course_deg
+    company_drift_m: float = InteractionParams.company_drift_m
+    company_drift_frac: float = InteractionParams.company_drift_frac
+    channel_along_within_deg: float = ChannelAuditParams.channel_along_within_deg
+    channel_crossing_from_deg: float = ChannelAuditParams.channel_crossing_from_deg
+    starboard_side_share: float = ChannelAuditParams.starboard_side_share
+    starboard_side_min_s: float = ChannelAuditParams.starboard_side_min_s
+    lane_crossing_within_deg: float = ChannelAuditParams.lane_crossing_within_deg
+    channel_confined_within_lengths: float = ChannelAuditParams.channel_confined_within_lengths
+    channel_narrow_within_lengths: float = ChannelAuditParams.channel_narrow_within_lengths
 
     @property
     def tracks(self) -> TrackParams:

@@ -16,7 +16,9 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..charts.channels import load_channels
+from ..core.audit import Fact
 from ..core.replay_results import EncounterOutcome
+from ..core.rows import EncounterSummary
 from ..timebase import DISPLAY_TIME_FORMAT
 from .chart_plot import (
     CHANNEL_AXIS_LABEL,
@@ -67,6 +69,15 @@ def cell(value: Any) -> Any:
     return value
 
 
+def target_restricted_text(s: EncounterSummary) -> str:
+    """The estimator's verdict on the target, and that her draught confines her to the
+    channel where it does: either is G_d's d3."""
+    estimated = cell(s.target_estimated_restricted) or ""
+    if s.target_confined_to_channel is not Fact.TRUE:
+        return estimated
+    return f"{estimated or 'not estimated'} by her arcs, confined to the channel by her draught"
+
+
 def verdict_text(outcome: EncounterOutcome) -> str:
     """The verdict in two lines, as the figure's title and index.md give it."""
     s = outcome.summary
@@ -80,7 +91,7 @@ def verdict_text(outcome: EncounterOutcome) -> str:
     return (
         f"{cell(s.situation)}{ambiguous}: own ship {cell(s.own_role_colregs)} → "
         f"{cell(s.own_role_final)} ({rule9}, {s.automaton_path}; rule {cell(s.deciding_rule)})"
-        f"\ntarget restricted: {cell(s.target_estimated_restricted)}, "
+        f"\ntarget restricted: {target_restricted_text(s)}, "
         f"CPA {s.cpa_m:.0f} m in {s.tcpa_s:.0f} s"
     )
 

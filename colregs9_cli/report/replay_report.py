@@ -28,7 +28,7 @@ from ..core.rows import (
 from ..core.rule9 import RULES_APPLIED
 from ..outputs import report_directory, save_figure, write_csv, write_json, write_text
 from .dossier import motion_figure, timeline_markdown
-from .encounter_figure import cell, encounter_figure, verdict_text
+from .encounter_figure import cell, encounter_figure, target_restricted_text, verdict_text
 from .html_page import HTML_NAME
 from .html_report import page_title, replay_html
 from .replay_geopackage import (
@@ -207,7 +207,7 @@ def format_index(result: ReplayResult, plots: bool) -> str:
         lines.append(
             f"| {s.encounter_id} | {cell(s.trigger_utc)} | {s.own_mmsi} | {s.target_mmsi} "
             f"| {situation_or_interaction(s)} | {'yes' if s.situation_ambiguous else ''} "
-            f"| {cell(s.own_role_colregs) or ''} | {cell(s.target_estimated_restricted) or ''} "
+            f"| {cell(s.own_role_colregs) or ''} | {target_restricted_text(s)} "
             f"| {s.automaton_path or ''} | {cell(s.deciding_rule) or ''} | {_give_way_text(s)} "
             f"| {_number(s.cpa_m, 0)} | {_number(s.actual_min_separation_m, 0)} | {acted} "
             f"| {links} |"
