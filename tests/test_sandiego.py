@@ -92,6 +92,7 @@ def test_report_geopackage_opens_with_every_layer(sandiego) -> None:
         "domains",
         "navigable_water",
         "vessel_tracks",
+        "lone_reports",
         "channels",
         "channel_axes",
     }

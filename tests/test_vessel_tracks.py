@@ -215,3 +215,26 @@ def test_the_domains_option_on_the_command_line(tmp_path: Path) -> None:
         lines = [line for line in bad.output.splitlines() if line.strip()]
         assert lines == ["Error: --domains 'red' is not one of all, restricted, none"]
         assert not (tmp_path / "bad").exists()
+
+
+def test_every_vessel_is_a_track_or_a_lone_report(sandiego_replay) -> None:
+    """San Diego: 41 of its 272 vessels have only pieces of one vertex (heard once, or at rest
+    reporting further apart than max_gap_s); ``lone_reports`` holds them as points at their
+    reports, so that the two layers together hold every vessel of the run."""
+    path = sandiego_replay.out_dir / "report.gpkg"
+    lines, _ = _read(path, "vessel_tracks")
+    fields, points = _read(path, "lone_reports")
+    vertices = sandiego_replay.vessel_tracks
+    sizes = vertices.groupby(["mmsi", "piece"])["t_s"].transform("size")
+    lone = vertices[sizes == 1]
+    assert len(fields) == len(lone) > 0
+    assert (shapely.get_type_id(points) == shapely.GeometryType.POINT).all()
+    assert np.array_equal(shapely.get_x(points), lone["lon_deg"].to_numpy())
+    assert np.array_equal(shapely.get_y(points), lone["lat_deg"].to_numpy())
+    assert np.array_equal(fields["mmsi"].to_numpy(), lone["mmsi"].to_numpy())
+    times = pd.to_datetime(fields["start_utc"], utc=True).dt.as_unit("ms").astype("int64")
+    assert np.array_equal(times.to_numpy(), np.round(lone["t_s"].to_numpy() * 1000.0))
+    assert fields["start_utc"].equals(fields["end_utc"])
+    every = set(vertices["mmsi"])
+    assert set(lines["mmsi"]) | set(fields["mmsi"]) == every
+    assert len(every) == 272 and len(every - set(lines["mmsi"])) == 41

@@ -218,6 +218,13 @@ STYLES: tuple[Style, ...] = (
         start_end_fields=("start_utc", "end_utc"),
     ),
     Style(
+        "lone_reports",
+        "the vessels heard too briefly for a track (one report, or at rest reporting "
+        "further apart than max_gap_s), shown at the time of each report",
+        symbol=Symbol("marker", VESSEL_RGBA),
+        start_end_fields=("start_utc", "end_utc"),
+    ),
+    Style(
         "navigable_water",
         "navigable water for the draught, outlined green",
         symbol=Symbol("fill", WATER_RGBA),

@@ -17,7 +17,12 @@ Layers (each only when it has features):
   line per piece (a vessel's track is split where her reports stop for longer than
   ``max_gap_s`` or jump), with time as the M value of each vertex (seconds since the Unix
   epoch, UTC) and ``start_utc``/``end_utc``, so that QGIS's Temporal Controller can play
-  them; a piece of one report is no line and is left out. Cut at the antimeridian;
+  them; a piece of one report is no line: it is in ``lone_reports``. Cut at the
+  antimeridian;
+- ``lone_reports``: the pieces too short for a line (one report, or reports within the same
+  10 s of thinning: a vessel heard once, or at rest reporting further apart than
+  ``max_gap_s``) as points, with the same fields (``start_utc`` = ``end_utc``), so that
+  every vessel of the run is in the file;
 - ``navigable_water``: the water deep enough for each target draught used, where a chart was
   given;
 - ``channels`` and ``channel_axes``: the charted channel areas a vessel of a triggered pair
@@ -296,6 +301,7 @@ def write_replay_geopackage(
     frame = result.frame
     layers = join_layers(parts) if parts else encounter_layers(outcomes, frame, domains)
     layers["vessel_tracks"] = vessel_track_layer(result.vessel_tracks)
+    layers["lone_reports"] = lone_report_layer(result.vessel_tracks)
     if chart is not None:
         draughts = sorted({o.summary.target_draught_m for o in outcomes})
         ukc_m = result.params.manoeuvrability.ukc_m
@@ -339,6 +345,7 @@ GEOMETRY_TYPES = {
     "tracks": "MultiLineString",
     "domains": "MultiPolygon",
     "vessel_tracks": "Measured MultiLineString",
+    "lone_reports": "Point",
     "navigable_water": "MultiPolygon",
     "channels": "MultiPolygon",
     "channel_axes": "MultiLineString",
@@ -385,15 +392,15 @@ def channel_layers(channels: Channels, used: set[str], frame: LocalFrame) -> dic
 _CHUNK_VERTICES = 200_000
 
 
-def vessel_track_layer(vertices: pd.DataFrame) -> Layer:
-    """``vessel_tracks`` (module docstring) from ``ReplayResult.vessel_tracks``: a feature
-    per piece of two vertices or more, in the order of the vertices (by MMSI and time)."""
+def _pieces(vertices: pd.DataFrame, lines: bool) -> tuple[np.ndarray, np.ndarray, pd.DataFrame]:
+    """The pieces of ``ReplayResult.vessel_tracks`` of two vertices or more (``lines``) or
+    of one: where each starts and ends in the vertices, and a row of fields per piece."""
     mmsi = vertices["mmsi"].to_numpy(dtype=np.int64)
     piece = vertices["piece"].to_numpy(dtype=np.int64)
     starts = np.flatnonzero(np.r_[True, (mmsi[1:] != mmsi[:-1]) | (piece[1:] != piece[:-1])])
     ends = np.r_[starts[1:], len(mmsi)].astype(np.int64)
-    lines = ends - starts >= 2
-    starts, ends = starts[lines], ends[lines]
+    wanted = (ends - starts >= 2) == lines
+    starts, ends = starts[wanted], ends[wanted]
     t_s = vertices["t_s"].to_numpy(dtype=float)
     first = vertices.iloc[starts]
     reports = vertices["reports"].to_numpy(dtype=np.int64).cumsum()
@@ -409,6 +416,25 @@ def vessel_track_layer(vertices: pd.DataFrame) -> Layer:
             "reports": reports[ends - 1] - np.r_[0, reports][starts],
         }
     )
+    return starts, ends, table
+
+
+def lone_report_layer(vertices: pd.DataFrame) -> Layer:
+    """``lone_reports`` (module docstring): a point per piece of one vertex, so that every
+    vessel of the run is in the GeoPackage."""
+    starts, _, table = _pieces(vertices, lines=False)
+    points = shapely.points(
+        vertices["lon_deg"].to_numpy(dtype=float)[starts],
+        vertices["lat_deg"].to_numpy(dtype=float)[starts],
+    )
+    return np.asarray(shapely.to_wkb(points, flavor="iso"), dtype=object), table
+
+
+def vessel_track_layer(vertices: pd.DataFrame) -> Layer:
+    """``vessel_tracks`` (module docstring) from ``ReplayResult.vessel_tracks``: a feature
+    per piece of two vertices or more, in the order of the vertices (by MMSI and time)."""
+    starts, ends, table = _pieces(vertices, lines=True)
+    t_s = vertices["t_s"].to_numpy(dtype=float)
     lon = vertices["lon_deg"].to_numpy(dtype=float)
     lat = vertices["lat_deg"].to_numpy(dtype=float)
     wkb = [np.zeros(0, dtype=object)]
