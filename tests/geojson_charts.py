@@ -1,5 +1,6 @@
 """Charts written as GeoJSON in a local frame's metres, for tests that need depth areas and
-channels of a shape they choose (GDAL reads them as it reads S-57 cells' layers)."""
+channels of a shape they choose (GDAL reads them as it reads S-57 cells' layers), and the
+shapes of such channels."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import shapely
 
 from colregs9_cli.geo import LocalFrame
@@ -41,3 +43,12 @@ def write_chart(
         collection.append(feature(frame, {"OBJL": "DEPARE", "DRVAL1": 30.0}, square))
     path.write_text(json.dumps({"type": "FeatureCollection", "features": collection}))
     return path
+
+
+def annulus_sector(inner_m: float, outer_m: float, to_deg: float) -> Any:
+    """A channel bending round the origin: the annulus sector from north clockwise to
+    ``to_deg`` (x east, y north)."""
+    angles = np.radians(np.linspace(0.0, to_deg, 91))
+    outer = np.column_stack([outer_m * np.sin(angles), outer_m * np.cos(angles)])
+    inner = np.column_stack([inner_m * np.sin(angles), inner_m * np.cos(angles)])[::-1]
+    return shapely.Polygon(np.concatenate([outer, inner]))

@@ -24,6 +24,8 @@ from colregs9_cli.core.vessel_defaults import VesselDimensions
 from colregs9_cli.errors import ParameterError
 from colregs9_cli.geo import LocalFrame
 
+from geojson_charts import annulus_sector
+
 FRAME = LocalFrame(55.0, 10.0)
 PARAMS = ChannelAuditParams()
 NO_DEPTHS = DraughtOnChart(None, VesselDimensions(100.0, 15.0, 6.0, (), ""), 0.0)
@@ -238,14 +240,6 @@ def test_outside_a_scheme_rule_10_does_not_apply() -> None:
 # -- a turn that follows a bend is not an action ---------------------------------------------
 
 
-def _bend(inner_m: float, outer_m: float, to_deg: float):
-    """An annulus sector round the origin from north clockwise to ``to_deg``."""
-    angles = np.radians(np.linspace(0.0, to_deg, 91))
-    outer = np.column_stack([outer_m * np.sin(angles), outer_m * np.cos(angles)])
-    inner = np.column_stack([inner_m * np.sin(angles), inner_m * np.cos(angles)])[::-1]
-    return shapely.Polygon(np.concatenate([outer, inner]))
-
-
 def _round_the_bend(extra_turn_deg: float) -> pd.DataFrame:
     """A vessel 30 m to starboard of the axis of a river bend (radius 1 km, turning 90°
     clockwise), following it from 10° to 70° round at 5 m/s; her course the tangent plus
@@ -268,7 +262,9 @@ RIVER = Channels(
     tuple(
         c
         for c in (
-            make_channel(FRAME, ChannelKind.FAIRWAY, _bend(900.0, 1100.0, 90.0), record_id="R1"),
+            make_channel(
+                FRAME, ChannelKind.FAIRWAY, annulus_sector(900.0, 1100.0, 90.0), record_id="R1"
+            ),
         )
         if c is not None
     ),

@@ -32,7 +32,7 @@ from colregs9_cli.errors import ChartError, ParameterError
 from colregs9_cli.geo import LocalFrame
 
 from fixture_files import FIXTURES, SANDIEGO_ENC
-from geojson_charts import feature, write_chart
+from geojson_charts import annulus_sector, feature, write_chart
 
 ANNAPOLIS_ENC = FIXTURES / "charts" / "noaa_enc_US5MD1MC.000"
 FRAME = LocalFrame(55.0, 10.0)
@@ -114,16 +114,8 @@ def test_an_l_shaped_channel_gives_each_leg_its_direction() -> None:
     assert list(across.relation) == [CROSSING]
 
 
-def _arc(inner_m: float, outer_m: float, to_deg: float) -> Any:
-    """An annulus sector round the origin from north clockwise to ``to_deg``."""
-    angles = np.radians(np.linspace(0.0, to_deg, 91))
-    outer = np.column_stack([outer_m * np.sin(angles), outer_m * np.cos(angles)])
-    inner = np.column_stack([inner_m * np.sin(angles), inner_m * np.cos(angles)])[::-1]
-    return shapely.Polygon(np.concatenate([outer, inner]))
-
-
 def test_an_arc_channel_follows_its_bend() -> None:
-    channels = _channels(_arc(900.0, 1100.0, 120.0))
+    channels = _channels(annulus_sector(900.0, 1100.0, 120.0))
     at_deg = np.array([30.0, 45.0, 60.0, 90.0])
     radius = np.full(4, 1000.0)
     east, north = radius * np.sin(np.radians(at_deg)), radius * np.cos(np.radians(at_deg))
