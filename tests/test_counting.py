@@ -3,11 +3,13 @@ scan or two (`ais.dataset_count`)."""
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pandas as pd
 import pyarrow as pa
 import pyarrow.compute as pc
+import pyarrow.parquet as pq
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -16,7 +18,7 @@ from typer.testing import CliRunner
 from colregs9_cli.ais import counting
 from colregs9_cli.ais.counting import RowCounts, row_runs
 from colregs9_cli.ais.dataset_count import DatasetCounts, count_dataset
-from colregs9_cli.ais.dataset_scan import Dataset
+from colregs9_cli.ais.dataset_scan import Dataset, Positions
 from colregs9_cli.ais.duplicates import ROW_ORDER, repeated_rows
 from colregs9_cli.ais.load import count_ais, load_ais
 from colregs9_cli.cli import app
@@ -102,6 +104,38 @@ def test_a_batch_in_runs_gives_one_row_a_run() -> None:
     ]
 
 
+column_values = st.one_of(
+    st.lists(st.sampled_from([None, 0.0, -0.0, float("nan"), 12.5, 200.0])).map(
+        lambda v: pa.array(v, pa.float64())
+    ),
+    st.lists(st.sampled_from([None, "Cargo", "Tanker", ""])).map(lambda v: pa.array(v)),
+    st.lists(st.sampled_from([None, "Cargo", "Tanker"])).map(
+        lambda v: pa.array(v, pa.string()).dictionary_encode()
+    ),
+    st.lists(st.sampled_from([None, -3, 0, 7])).map(lambda v: pa.array(v, pa.int8())),
+    st.lists(st.sampled_from([None, 0, 1000])).map(
+        lambda v: pa.array(v, pa.timestamp("ms", tz="UTC"))
+    ),
+    st.lists(st.sampled_from([None, True, False])).map(lambda v: pa.array(v, pa.bool_())),
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(column_values, st.integers(0, 5), st.integers(0, 5))
+def test_a_row_changes_where_the_grouping_tells_it_from_the_row_before(
+    column: pa.Array, start: int, end: int
+) -> None:
+    """``changes`` (over Arrow's buffers, a slice of them too) marks a row exactly where it
+    and the row before fall in two groups of Arrow's hash grouping (a null equals a null, a
+    NaN a NaN, 0.0 is not -0.0)."""
+    column = column.slice(start, max(len(column) - start - end, 0))
+    groups = pa.table({"v": column, "row": range(len(column))}).group_by("v")
+    numbered = groups.aggregate([("row", "list")]).column("row_list").to_pylist()
+    group_of = {row: number for number, rows in enumerate(numbered) for row in rows}
+    want = [group_of[row] != group_of[row - 1] for row in range(1, len(column))]
+    assert counting.changes(column).tolist() == want
+
+
 def test_rows_that_change_at_every_row_are_kept_as_they_are() -> None:
     """Rows in time order (the vessels interleaved) make a run of every row: counting their
     runs would cost more than it saves, so each row stands for itself."""
@@ -135,6 +169,35 @@ def test_a_query_of_everything_counts_as_a_query_that_selects_all(two_day_datase
     assert _as_lists(everything) == _as_lists(world)
     positions = pc.sum(everything.position_counts.column("n_positions")).as_py()
     assert positions == sum(f.rows for f in dataset.files) - dataset.static_rows
+
+
+@pytest.mark.parametrize("rewrite", ["statistics left out", "positions and statics mixed"])
+def test_row_groups_the_statistics_cannot_sort_are_counted_alike(
+    two_day_dataset: Path, tmp_path: Path, rewrite: str
+) -> None:
+    """A query of everything reads the coordinates only of the row groups whose statistics
+    do not tell positions from static reports: files written without statistics, or with
+    both in a row group (not as colregs9 writes them), count as the dataset ingest wrote."""
+    copy = tmp_path / "ais"
+    shutil.copytree(two_day_dataset, copy)
+    for path in copy.rglob("date=*/*.parquet"):
+        table = pq.read_table(path)
+        if rewrite == "statistics left out":
+            pq.write_table(table, path, write_statistics=False)
+        else:  # by MMSI: a vessel's static reports among its positions
+            pq.write_table(table.sort_by("mmsi"), path, row_group_size=700)
+    written, rewritten = Dataset.open(two_day_dataset), Dataset.open(copy)
+    assert rewritten.static_rows == written.static_rows > 0
+    for dataset in (written, rewritten):
+        kinds = {kind: _rows(dataset, kind) for kind in Positions}
+        assert sum(kinds.values()) == dataset.rows
+        assert (kinds[Positions.SOME] > 0) is (dataset is rewritten)
+    query = everything_query()
+    assert _as_lists(count_dataset(rewritten, query)) == _as_lists(count_dataset(written, query))
+
+
+def _rows(dataset: Dataset, kind: Positions) -> int:
+    return sum(table.num_rows for table in dataset.row_groups(kind, ["mmsi"]))
 
 
 duplicated_rows = st.lists(

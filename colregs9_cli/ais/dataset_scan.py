@@ -8,7 +8,8 @@ manifest and the files' footers only: every listed file is there with the canoni
 (of its input's format version) and the row count listed, and no other Parquet file lies in
 it. The scans are ``pyarrow.dataset`` scans with the query pushed down: the time window
 prunes partitions and, with the region, row groups by their statistics; only the columns
-asked for are decoded.
+asked for are decoded. ``Dataset.row_groups`` reads whole row groups instead, told apart by
+their statistics (``Positions``), with Parquet's own reader.
 
 Format versions: 3 adds to each input ingested through a query the dimension reports of its
 rows that the query left out (``_dimension_reports/part-<sha16>.parquet``, listed in the
@@ -30,9 +31,12 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from datetime import UTC, date, datetime, timedelta
+from enum import Enum
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -72,6 +76,9 @@ _REMEDY = "re-create the dataset with colregs9 ingest"
 # moved from code comments").
 _BATCH_READAHEAD = 4
 _FRAGMENT_READAHEAD = 1
+# Row groups read at once by ``Dataset.row_groups`` (ingest's hold 65,536 rows): fewer or
+# more were slower (tests/benchmarks/README.md, "the counts read without the coordinates").
+_ROW_GROUPS_READ = 4
 
 
 def is_dataset(path: Path) -> bool:
@@ -217,6 +224,18 @@ def _listed_reports(entry: dict[str, Any], version: int) -> DatasetFile | None:
     return DatasetFile(str(listed["path"]), None, int(listed["rows"]))
 
 
+class Positions(Enum):
+    """Row groups told apart by the null counts of latitude and longitude in their
+    statistics (the footers: nothing decoded). A row has a position when it has both, as
+    the pushdown has it (``position_filter``). ``colregs9 ingest`` writes positions and
+    static reports in row groups of their own, so a read that only needs to tell them apart
+    need not decode the coordinates (``Dataset.row_groups``)."""
+
+    ALL = "all"  # every row has a position
+    NONE = "none"  # no row has one
+    SOME = "some"  # the others, and those whose statistics lack null counts
+
+
 @dataclass(frozen=True)
 class Dataset:
     """An opened, checked dataset (see the module docstring)."""
@@ -336,6 +355,22 @@ class Dataset:
                 f"{self.directory}: cannot read the dataset ({exc}); {_REMEDY}"
             ) from None
 
+    def row_groups(
+        self, positions: Positions, columns: Sequence[str], dictionaries: Sequence[str] = ()
+    ) -> Iterator[pa.Table]:
+        """Every row of the row groups of the kind ``positions``, with ``columns`` (columns
+        that every format version has), a few row groups at a time in file order.
+        ``dictionaries``: string columns read as Arrow dictionaries of the Parquet
+        dictionaries' values, not as strings. Without a filter, Parquet's own reader
+        decodes with less work than a scan; the next row groups are read while the caller
+        works on these."""
+        try:
+            yield from _read_ahead(_row_group_reads(self, positions, columns, dictionaries))
+        except (pa.ArrowException, OSError) as exc:
+            raise InputFileError(
+                f"{self.directory}: cannot read the dataset ({exc}); {_REMEDY}"
+            ) from None
+
     def time_range(self) -> tuple[datetime, datetime] | None:
         """The first and last timestamps of the position rows, from the row groups'
         statistics (row groups of static reports left out); None without positions."""
@@ -374,6 +409,65 @@ def _utc(milliseconds: int) -> datetime:
 def _hidden(relative: Path) -> bool:
     """Paths pyarrow's discovery would skip too: an ingest's staging directory."""
     return any(part.startswith((".", "_")) for part in relative.parts)
+
+
+def _row_group_reads(
+    dataset: Dataset, positions: Positions, columns: Sequence[str], dictionaries: Sequence[str]
+) -> Iterator[Callable[[], pa.Table]]:
+    """The reads of ``Dataset.row_groups``, a few row groups each."""
+    for fragment in dataset.arrow.get_fragments():
+        kinds = _row_group_positions(fragment)
+        wanted = [index for index, kind in enumerate(kinds) if kind is positions]
+        for start in range(0, len(wanted), _ROW_GROUPS_READ):
+            some = wanted[start : start + _ROW_GROUPS_READ]
+            yield partial(_read_row_groups, fragment, some, columns, dictionaries)
+
+
+def _read_row_groups(
+    fragment: ds.ParquetFileFragment,
+    groups: Sequence[int],
+    columns: Sequence[str],
+    dictionaries: Sequence[str],
+) -> pa.Table:
+    with pq.ParquetFile(
+        fragment.path, metadata=fragment.metadata, read_dictionary=dictionaries
+    ) as parquet:
+        return parquet.read_row_groups(groups, columns=list(columns))
+
+
+def _read_ahead(reads: Iterator[Callable[[], pa.Table]]) -> Iterator[pa.Table]:
+    """The tables of ``reads``, each read on a thread while the caller works on the one
+    before."""
+    with ThreadPoolExecutor(1) as reader:
+        ahead: Future[pa.Table] | None = None
+        for read in reads:
+            following = reader.submit(read)
+            if ahead is not None:
+                yield ahead.result()
+            ahead = following
+        if ahead is not None:
+            yield ahead.result()
+
+
+def _row_group_positions(fragment: ds.ParquetFileFragment) -> list[Positions]:
+    """The kind of each row group of ``fragment`` (footer read when the dataset opened)."""
+    metadata = fragment.metadata
+    # By name: another tool may have written the columns in another order.
+    lat = fragment.physical_schema.get_field_index("lat_deg")
+    lon = fragment.physical_schema.get_field_index("lon_deg")
+    kinds = []
+    for index in range(metadata.num_row_groups):
+        group = metadata.row_group(index)
+        nulls = [group.column(column).statistics for column in (lat, lon)]
+        if any(stats is None or not stats.has_null_count for stats in nulls):
+            kinds.append(Positions.SOME)
+        elif all(stats.null_count == 0 for stats in nulls):
+            kinds.append(Positions.ALL)
+        elif any(stats.null_count == group.num_rows for stats in nulls):
+            kinds.append(Positions.NONE)
+        else:
+            kinds.append(Positions.SOME)
+    return kinds
 
 
 def _check_fragment(
