@@ -417,3 +417,24 @@ def test_a_ship_her_draught_confines_to_a_cut_stands_on_under_rule_9(
     else:
         assert "target restricted: false, CPA" in title
         assert "confined to the channel by her draught: false" in ship_line
+
+
+def test_the_confinement_is_the_same_for_any_slab_length(tmp_path: Path) -> None:
+    from colregs9_cli.jobs.replay import run_replay
+    from colregs9_cli.jobs.simulate import simulate_scenario
+
+    ais = tmp_path / "cut.csv"
+    simulate_scenario(_scenario(tmp_path, 9.5), ais)
+    arcs = {"swing_model": "fixed", "swing_deg_per_m": 0.36, "horizon_s": 30.0}
+    tables = [
+        run_replay(
+            [ais],
+            chart_paths=[tmp_path / "cut.geojson"],
+            plots=False,
+            write=False,
+            overrides={"manoeuvrability": arcs, "replay": {"slab_s": slab_s}},
+        ).pairs_table
+        for slab_s in (120.0, 3600.0)
+    ]
+    assert tables[0]["confined_to_channel_a"].tolist() == ["true"]
+    pd.testing.assert_frame_equal(tables[0], tables[1])
