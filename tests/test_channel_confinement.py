@@ -166,6 +166,23 @@ def test_channel_areas_side_by_side_are_one_channel(tmp_path: Path) -> None:
     assert centre.fact is Fact.TRUE and "300 m wide for her" in centre.basis
 
 
+def test_she_is_judged_in_the_channel_she_was_in_at_the_trigger(tmp_path: Path) -> None:
+    # The cut ends 150 m ahead of her, where a fairway 2 km wide opens over 30 m water: half
+    # her way to the closest approach lies in it. The stations are those in the cut.
+    chart, channels = _cut_chart(
+        tmp_path,
+        _bank(4.0, -3000, 3000),
+        ({"OBJL": "DRGARE", "OBJNAM": "Cut", "DRVAL1": 12.0}, shapely.box(-100, -3000, 100, 150)),
+        ({"OBJL": "DEPARE", "DRVAL1": 30.0}, shapely.box(-1000, 150, 1000, 3000)),
+        ({"OBJL": "FAIRWY", "OBJNAM": "Wide"}, shapely.box(-1000, 150, 1000, 3000)),
+    )
+    found = _judge(chart, channels, 0.0, 0.0, _vessel(150.0, 9.5))
+    assert found.at_trigger.channel == "Cut" and found.at_least_separation.channel == "Wide"
+    assert found.confined.fact is Fact.TRUE
+    assert "confined at 9 of the 9 judged" in found.confined.basis
+    assert "the channel 200 m wide for her" in found.confined.basis
+
+
 def test_one_wreck_abeam_does_not_decide(tmp_path: Path) -> None:
     # 30 m water east of the cut, open; an unsounded wreck 60 m east of her track, inside the
     # cut, abeam of her at the trigger only: one station of nine is shut, the rest open.

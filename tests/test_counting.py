@@ -4,6 +4,7 @@ scan or two (`ais.dataset_count`)."""
 from __future__ import annotations
 
 import shutil
+import threading
 from pathlib import Path
 
 import pandas as pd
@@ -22,7 +23,7 @@ from colregs9_cli.ais.dataset_scan import Dataset, Positions
 from colregs9_cli.ais.duplicates import ROW_ORDER, repeated_rows
 from colregs9_cli.ais.load import count_ais, load_ais
 from colregs9_cli.cli import app
-from colregs9_cli.errors import NoDataError
+from colregs9_cli.errors import InputFileError, NoDataError
 from colregs9_cli.jobs.ingest import ingest, ingest_with_query
 from colregs9_cli.query import Query, Region, everything_query
 
@@ -198,6 +199,31 @@ def test_row_groups_the_statistics_cannot_sort_are_counted_alike(
 
 def _rows(dataset: Dataset, kind: Positions) -> int:
     return sum(table.num_rows for table in dataset.row_groups(kind, ["mmsi"]))
+
+
+def test_a_read_left_early_stops_its_thread(two_day_dataset: Path) -> None:
+    """The row groups are read one read ahead, on a thread of their own: a caller that
+    stops after the first table (an error in its counting, say) leaves no thread behind."""
+    before = threading.active_count()
+    reads = Dataset.open(two_day_dataset).row_groups(Positions.ALL, ["mmsi"])
+    assert next(reads).num_rows > 0
+    assert threading.active_count() == before + 1  # the read ahead
+    reads.close()
+    assert threading.active_count() == before
+
+
+def test_a_file_damaged_after_the_dataset_opened_is_one_error(
+    two_day_dataset: Path, tmp_path: Path
+) -> None:
+    copy = tmp_path / "ais"
+    shutil.copytree(two_day_dataset, copy)
+    dataset = Dataset.open(copy)
+    (first, *_) = sorted(copy.rglob("date=*/*.parquet"))
+    data = first.read_bytes()
+    first.write_bytes(data[:4] + bytes(len(data) - 8) + data[-4:])  # the pages zeroed
+    with pytest.raises(InputFileError, match="cannot read the dataset"):
+        for _ in dataset.row_groups(Positions.ALL, ["mmsi", "length_m"]):
+            pass
 
 
 duplicated_rows = st.lists(

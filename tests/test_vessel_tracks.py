@@ -192,7 +192,20 @@ def test_vessel_tracks_carry_a_temporal_style(nmea_report) -> None:
             "SELECT styleQML FROM layer_styles WHERE f_table_name = 'vessel_tracks'"
         ).fetchone()
     assert '<temporal enabled="1" mode="2" startField="start_utc" endField="end_utc"' in qml
+    assert 'limitMode="0"' in qml
     assert "GeometryGenerator" in qml and "epoch(@map_end_time)" in qml
+
+
+def test_lone_reports_show_in_the_frame_that_begins_at_them(nmea_report) -> None:
+    """A lone report starts where it ends: with QGIS's limit mode 0 (a frame shows the
+    features whose end is after its beginning) it would show in no frame; its style keeps
+    the end in (mode 1: QGIS 3.22 then filters ``"end_utc" >= <frame begin>``)."""
+    with sqlite3.connect(nmea_report.out_dir / "report.gpkg") as db:
+        (qml,) = db.execute(
+            "SELECT styleQML FROM layer_styles WHERE f_table_name = 'lone_reports'"
+        ).fetchone()
+    assert '<temporal enabled="1" mode="2" startField="start_utc" endField="end_utc"' in qml
+    assert 'limitMode="1"' in qml
 
 
 def test_the_domains_option_on_the_command_line(tmp_path: Path) -> None:

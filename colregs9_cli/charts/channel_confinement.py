@@ -1,6 +1,6 @@
 """The water on either hand of a vessel proceeding along a charted channel, for her draught:
 what rule 9(b) and (c)'s "a vessel which can safely navigate only within a narrow channel or
-fairway" reads from the chart (``core.channel_audit.confined_to_channel`` judges it).
+fairway" reads from the chart (``core.confinement.confined_to_channel`` judges it).
 
 Through her position, square to the channel's local axis, the section is cut twice:
 

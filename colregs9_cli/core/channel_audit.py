@@ -77,8 +77,8 @@ class ChannelAuditParams:
     starboard_side_share: float = 0.8
     starboard_side_min_s: float = 30.0
     lane_crossing_within_deg: float = 15.0
-    channel_confined_within_lengths: float = 1.0
-    channel_narrow_within_lengths: float = 5.0
+    channel_confined_within_lengths: float = ConfinementParams.within_lengths
+    channel_narrow_within_lengths: float = ConfinementParams.narrow_within_lengths
 
     def __post_init__(self) -> None:
         if not 0.5 <= self.starboard_side_share <= 1.0:
@@ -95,8 +95,8 @@ class ChannelAuditParams:
                 f"[replay] lane_crossing_within_deg = {self.lane_crossing_within_deg!r}: give "
                 "0 to 45 degrees"
             )
-        self.angles()  # the angles are checked there, and the confinement's thresholds
-        self.confinement()
+        self.angles()  # the angles are checked there
+        self.confinement()  # and the confinement's thresholds there
 
     def confinement(self) -> ConfinementParams:
         return ConfinementParams(
@@ -254,8 +254,8 @@ def vessel_in_channel(
 ) -> VesselInChannel:
     """One vessel (``prefix`` of the pair's series) over ``window`` (rows from the trigger):
     her places at the trigger (row 0) and at the least separation (``cpa_row``), rule 9(a)
-    up to it, and whether her ``draught`` confines her at the trigger to the channel she
-    proceeds along."""
+    up to it, and whether her ``draught`` confines her to the narrow channel she proceeds
+    along at the trigger (``confinement.py``)."""
     if channels is None or window.empty:
         return NOT_CHARTED
     last = len(window) - 1 if cpa_row is None else cpa_row

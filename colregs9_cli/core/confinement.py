@@ -3,9 +3,9 @@
 read from the chart (docs/design.md, "Charted channels in replay").
 
 She is judged at stations along her own track from the trigger to the closest approach, on
-the rows where she proceeds along a charted channel (at most ``MAX_STATIONS``, evenly
-spaced, the trigger first): at each, on the section square to the channel's axis
-(``charts.channel_confinement``),
+the rows where she proceeds along the charted channel she proceeds along at the trigger (at
+most ``MAX_STATIONS``, evenly spaced, the trigger first): at each, on the section square to
+the channel's axis (``charts.channel_confinement``),
 
 - *confined* when the water navigable for her draught plus the UKC reaches less than
   ``within_lengths`` (1) of her lengths beyond the channel's limits on both hands, and the
@@ -107,7 +107,10 @@ def confined_to_channel(
         )
     if draught.chart is None:
         return ConfinedToChannel(Fact.INSUFFICIENT, f"along {label}; no depths charted")
-    along = np.flatnonzero(facts.relation == ChannelRelation.ALONG)
+    # Along the channel she was along at the trigger, as the bend of its axis is followed.
+    along = np.flatnonzero(
+        (facts.relation == ChannelRelation.ALONG) & (facts.channel == facts.channel[0])
+    )
     stations = along[np.unique(np.linspace(0, len(along) - 1, MAX_STATIONS).round().astype(int))]
     within_m = params.within_lengths * dimensions.length_m
     narrow_m = params.narrow_within_lengths * dimensions.length_m

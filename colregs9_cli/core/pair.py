@@ -702,7 +702,8 @@ def channel_standing(
     """What rule 9's clauses read of a vessel: along or crossing a charted channel (at the
     trigger, or crossing at the least separation), under 20 m (a reported length) or
     sailing, fishing (her AIS type, or her navigational status at the trigger where it is
-    believed), confined to the channel by her draught at the trigger."""
+    believed), confined by her draught to the narrow channel she proceeds along at the
+    trigger (``confinement.py``)."""
     ship_type = text_or_none(static.get("ship_type"))
     belief = claims.belief(status)
     used = status if belief.believed else None

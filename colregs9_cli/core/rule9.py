@@ -17,9 +17,10 @@ Events, as in the paper: d1 the target needs to give way under rules 13–15 (a 
 overtaking in which own ship stands on, and every head-on); d2 the target's AIS navigational
 status is in the restricted set (``Rule9Params.restricted_nav_statuses``, default {3, 4});
 d3 the manoeuvrability estimator says the target is restricted, or, where the chart charts
-channels, she proceeds along one to which her draught confines her (the water navigable for
-her ends within her length of its limits on both hands: ``channel_audit.confined_to_channel``,
-rule 9(b)'s "a vessel which can safely navigate only within a narrow channel"). The
+channels, she proceeds along a narrow one to which her draught confines her (the water
+navigable for her ends within her length of its limits on both hands, in a channel under
+five of her lengths wide for her: ``confinement.confined_to_channel``, rule 9(b)'s "a vessel
+which can safely navigate only within a narrow channel"). The
 estimator's "unknown" is ¬d3, recorded as ``unknown`` and never as "not restricted"; so is a
 missing nav status for d2.
 D4 means the target is not expected to give way: she stands on and own ship gives way.
@@ -405,7 +406,8 @@ class ChannelStanding:
     small_or_sailing: bool
     fishing: bool
     # Along a charted channel, and the water navigable for her draught ends within her
-    # length of its limits on both hands (``channel_audit.confined_to_channel``).
+    # length of its limits on both hands, in a channel narrow for her
+    # (``confinement.confined_to_channel``).
     confined_to_channel: bool = False
 
 

@@ -58,6 +58,12 @@ LEAST_SEPARATION_COLOUR = "tab:red"
 LEAST_SEPARATION_LABEL = "least separation"
 # Under the legend when a vessel's label has a dimension marked with ``*``.
 DEFAULTED_NOTE = "* dimension not in AIS: a default was used"
+# The map's figure, whose height holds a legend of up to LEGEND_ROWS_FITTED rows; each row
+# more adds LEGEND_ROW_IN inches (a line of small text and its spacing).
+FIGURE_WIDTH_IN = 8.5
+FIGURE_HEIGHT_IN = 9.2
+LEGEND_ROWS_FITTED = 8
+LEGEND_ROW_IN = 0.22
 
 
 def cell(value: Any) -> Any:
@@ -320,19 +326,11 @@ def _mark_least_separation(ax: Any, outcome: EncounterOutcome) -> None:
     )
 
 
-# The map's figure, whose height holds a legend of up to LEGEND_ROWS_IN_HEIGHT rows; each
-# row more adds LEGEND_ROW_IN (a line of small text and its spacing).
-FIGURE_WIDTH_IN = 8.5
-FIGURE_HEIGHT_IN = 9.2
-LEGEND_ROWS_IN_HEIGHT = 8
-LEGEND_ROW_IN = 0.22
-
-
 def _legend_below(figure: Figure, ax: Any) -> None:
     """A compact legend under the axes, so that it covers nothing: own ship, then the arcs
     and the chart, in one column; the target, then the ellipses, in the other, and what
     ``*`` means when a vessel's label has one. The figure grows by the rows past
-    ``LEGEND_ROWS_IN_HEIGHT``, so that a long legend does not squeeze the map and its title
+    ``LEGEND_ROWS_FITTED``, so that a long legend does not squeeze the map and its title
     out of the figure."""
     handles, labels = ax.get_legend_handles_labels()
     entries = list(zip(handles, labels, strict=True))
@@ -354,7 +352,7 @@ def _legend_below(figure: Figure, ax: Any) -> None:
     rows = max(len(c) for c in columns)
     # matplotlib fills a legend column by column: pad each to the same height.
     padded = [entry for c in columns for entry in c + [blank] * (rows - len(c))]
-    extra_rows = max(0, rows - LEGEND_ROWS_IN_HEIGHT)
+    extra_rows = max(0, rows - LEGEND_ROWS_FITTED)
     figure.set_figheight(FIGURE_HEIGHT_IN + extra_rows * LEGEND_ROW_IN)
     figure.legend(
         [h for h, _ in padded],

@@ -128,6 +128,9 @@ class Style:
     categories: Sequence[tuple[str, str, Symbol]] = ()
     # The Temporal Controller's "separate fields for start and end date/time" (QGIS's mode 2).
     start_end_fields: tuple[str, str] | None = None
+    # Whether a frame that begins at a feature's end still shows it (QGIS's limit mode 1):
+    # a feature whose start is its end shows in no frame otherwise.
+    include_end: bool = False
 
     def qml(self) -> str:
         if self.field is None:
@@ -154,7 +157,7 @@ class Style:
             start, end = self.start_end_fields
             temporal = (
                 f'<temporal enabled="1" mode="2" startField={quoteattr(start)} '
-                f'endField={quoteattr(end)} accumulate="0" limitMode="0">'
+                f'endField={quoteattr(end)} accumulate="0" limitMode="{int(self.include_end)}">'
                 "<fixedRange><start></start><end></end></fixedRange></temporal>"
             )
         categories = "Symbology|Temporal" if temporal else "Symbology"
@@ -223,6 +226,7 @@ STYLES: tuple[Style, ...] = (
         "further apart than max_gap_s), shown at the time of each report",
         symbol=Symbol("marker", VESSEL_RGBA),
         start_end_fields=("start_utc", "end_utc"),
+        include_end=True,
     ),
     Style(
         "navigable_water",

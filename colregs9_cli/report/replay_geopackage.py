@@ -399,7 +399,7 @@ def _pieces(vertices: pd.DataFrame, lines: bool) -> tuple[np.ndarray, np.ndarray
     piece = vertices["piece"].to_numpy(dtype=np.int64)
     starts = np.flatnonzero(np.r_[True, (mmsi[1:] != mmsi[:-1]) | (piece[1:] != piece[:-1])])
     ends = np.r_[starts[1:], len(mmsi)].astype(np.int64)
-    wanted = (ends - starts >= 2) == lines
+    wanted = ((ends - starts >= 2) == lines) & (ends > starts)
     starts, ends = starts[wanted], ends[wanted]
     t_s = vertices["t_s"].to_numpy(dtype=float)
     first = vertices.iloc[starts]
