@@ -302,6 +302,15 @@ def replay_command(
             "report.gpkg); none.",
         ),
     ] = "restricted",
+    vessel_tracks: Annotated[
+        bool,
+        typer.Option(
+            "--vessel-tracks/--no-vessel-tracks",
+            help="Every vessel's track over the run in report.gpkg (vessel_tracks, "
+            "lone_reports), for QGIS's Temporal Controller: about 50 bytes a vertex, 149 MB "
+            "of a national day; leave them out of long runs.",
+        ),
+    ] = True,
     slab_minutes: Annotated[
         float | None,
         typer.Option(
@@ -381,6 +390,7 @@ def replay_command(
             scheduler=scheduler,
             scratch_dir=scratch,
             domains=domains,
+            vessel_tracks=vessel_tracks,
         )
     typer.echo(result.text, nl=False)
     if not quiet:

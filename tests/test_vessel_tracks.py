@@ -230,6 +230,25 @@ def test_the_domains_option_on_the_command_line(tmp_path: Path) -> None:
         assert not (tmp_path / "bad").exists()
 
 
+def test_vessel_tracks_can_be_left_out(nmea_report, tmp_path: Path) -> None:
+    """--no-vessel-tracks: neither vessel_tracks nor lone_reports, run.json says so, and the
+    encounters are those of the run with them."""
+    out = tmp_path / "without"
+    result = CliRunner().invoke(
+        app, ["replay", str(NMEA), "--quiet", "--no-plots", "--no-vessel-tracks", "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    layers = _layers(out / "report.gpkg")
+    assert "vessel_tracks" not in layers and "lone_reports" not in layers
+    assert "encounters" in layers
+    manifest = json.loads((out / "run.json").read_text(encoding="utf-8"))
+    assert manifest["parameters"]["vessel_tracks"] is False
+    with_them = json.loads((nmea_report.out_dir / "run.json").read_text(encoding="utf-8"))
+    assert with_them["parameters"]["vessel_tracks"] is True
+    for name in ("pairs.csv", "encounters.csv"):
+        assert (out / name).read_bytes() == (nmea_report.out_dir / name).read_bytes()
+
+
 def test_every_vessel_is_a_track_or_a_lone_report(sandiego_replay) -> None:
     """San Diego: 41 of its 272 vessels have only pieces of one vertex (heard once, or at rest
     reporting further apart than max_gap_s); ``lone_reports`` holds them as points at their

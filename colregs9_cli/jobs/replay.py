@@ -235,10 +235,13 @@ def run_replay(
     scheduler: str | None = None,
     scratch_dir: Path | None = None,
     domains: Domains | str = Domains.RESTRICTED,
+    vessel_tracks: bool = True,
 ) -> ReplayResult:
     """Replay ``ais_paths`` and write the reports (see the module docstring); with
     ``write=False`` nothing is written (the result is in memory only). ``domains``: which
-    ship-domain ellipses report.gpkg holds (all, restricted or none; recorded in run.json).
+    ship-domain ellipses report.gpkg holds (all, restricted or none; recorded in run.json);
+    ``vessel_tracks``: whether it holds every vessel's track (recorded too; without, the
+    spill is not read for them).
 
     Errors: an own MMSI not in the data, fewer than two vessels (``NoDataError``, exit 3); a
     chart that covers none of the AIS (``ChartError``, exit 2); bad files or parameters. A run
@@ -297,7 +300,7 @@ def run_replay(
                     chart,
                     bar,
                 )
-            vessel_tracks = _vessel_tracks(segmentation)  # before the spill goes
+            tracks = _vessel_tracks(segmentation, vessel_tracks)  # before the spill goes
         counts = _counts(segmentation, results)
         outcomes = tuple(pair for result in results for pair in result.pairs)
         manifest = build_manifest(
@@ -314,6 +317,7 @@ def run_replay(
             accept_chart_gaps,
         )
         manifest["parameters"]["domains"] = domains.value
+        manifest["parameters"]["vessel_tracks"] = vessel_tracks
         manifest["slabs"] = {
             "slab_s": params.replay.slab_s,
             "slabs": len(slabs),
@@ -329,7 +333,7 @@ def run_replay(
             counts=counts,
             manifest=manifest,
             files=(),
-            vessel_tracks=vessel_tracks,
+            vessel_tracks=tracks,
         )
         files: tuple[Path, ...] = ()
         if write:
@@ -359,10 +363,11 @@ def domains_choice(value: Domains | str) -> Domains:
         raise ParameterError(f"--domains {value!r} is not one of {choices}") from None
 
 
-def _vessel_tracks(segmentation: Segmentation) -> pd.DataFrame:
+def _vessel_tracks(segmentation: Segmentation, wanted: bool) -> pd.DataFrame:
     """Every vessel's track (``slabs.track_vertices``) with her name, ship type and length
-    from her static reports, as categories: a few bytes a vertex."""
-    vertices = track_vertices(segmentation.spill)
+    from her static reports, as categories: a few bytes a vertex; none unless ``wanted``."""
+    spill = segmentation.spill if wanted else dataclasses.replace(segmentation.spill, files=())
+    vertices = track_vertices(spill)
     mmsi = vertices["mmsi"].to_numpy()
     new_vessel = np.diff(mmsi, prepend=-1) != 0
     # Per vessel, then spread by code: the static table spread over millions of vertices
