@@ -14,7 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_encounters import FRAME, PARAMS, T0, T0_S, head_to_head, straight_track, tracks_of
 
-from colregs9_cli.core.encounters import Encounter, EncounterParams, find_encounters
+from colregs9_cli.core.encounters import Encounter, find_encounters
+from colregs9_cli.core.pair_search import EncounterParams
 from colregs9_cli.core.passing import PassingParams
 from colregs9_cli.geo import velocity_mps
 

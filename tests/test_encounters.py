@@ -14,12 +14,10 @@ from pyproj import Geod
 from colregs9_cli.core import encounters as encounters_module
 from colregs9_cli.core.encounters import (
     SERIES_VESSEL_COLUMNS,
-    candidate_pairs,
-    cpa_tcpa,
     encounter_series,
     find_encounters,
-    trigger_mask,
 )
+from colregs9_cli.core.pair_search import candidate_pairs, cpa_tcpa, trigger_mask
 from colregs9_cli.core.tracks import build_tracks
 from colregs9_cli.errors import NoDataError, ParameterError, QueryError
 from colregs9_cli.geo import LocalFrame, velocity_mps

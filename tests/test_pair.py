@@ -1,4 +1,5 @@
-"""The pair model (``core/pair.py``): one evaluation of a pair, seen from either seat."""
+"""The pair model (``core/pair.py``, ``core/pair_model.py``): one evaluation of a pair, seen
+from either seat."""
 
 from __future__ import annotations
 

@@ -7,7 +7,7 @@ import pytest
 
 from colregs9_cli.core.colregs import Role, Situation
 from colregs9_cli.core.manoeuvrability import Restriction
-from colregs9_cli.core.pair import rests_on_defaults
+from colregs9_cli.core.pair_model import rests_on_defaults
 from colregs9_cli.core.rule9 import DecidingRule, decide_pair
 from colregs9_cli.core.vessel_defaults import VesselDimensions
 

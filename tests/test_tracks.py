@@ -17,7 +17,8 @@ from test_replay_cli import write_dma
 from colregs9_cli.ais.ledger import RejectsLedger
 from colregs9_cli.ais.nmea import read_nmea
 from colregs9_cli.core.ais_claims import Fixes, SogCheckParams, contradicted_sog
-from colregs9_cli.core.encounters import EncounterParams, find_encounters
+from colregs9_cli.core.encounters import find_encounters
+from colregs9_cli.core.pair_search import EncounterParams
 from colregs9_cli.core.tracks import (
     NO_TRACK_STATS,
     SAMPLE_COLUMNS,

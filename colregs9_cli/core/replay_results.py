@@ -21,7 +21,8 @@ import pandas as pd
 from ..geo import LocalFrame, velocity_mps
 from .interactions import InteractionKind
 from .manoeuvrability import ManoeuvrabilityAssessment
-from .pair import PairEvaluation, PairParams, Seat
+from .pair import PairParams
+from .pair_model import PairEvaluation, Seat
 from .rows import EncounterSummary, PairSummary, pair_row, seat_row, seat_series
 
 

@@ -1,6 +1,6 @@
 """The rows of pairs.csv and encounters.csv and the columns of each seat's time series: each a
-projection of the pair model (``pair.py``), so that a new column is its field and one line in
-its projection, here.
+projection of the pair model (``pair_model.py``), so that a new column is its field and one
+line in its projection, here.
 
 ``PairSummary`` is the pair in vessel order (a, b); ``EncounterSummary`` and the series are
 one ``Seat`` of it (own ship, target). Everything about the pair (situation, final roles,
@@ -21,7 +21,7 @@ from .channel_audit import VesselInChannel
 from .colregs import Role, Situation, SituationBasis
 from .interactions import InteractionKind
 from .manoeuvrability import Restriction, SwingModel
-from .pair import PairEvaluation, Seat, VesselAtTrigger, reports_restricted
+from .pair_model import PairEvaluation, Seat, VesselAtTrigger, reports_restricted
 from .rule9 import DecidingRule, Rule9Clause
 
 

@@ -316,14 +316,9 @@ def run_replay(
             outcomes,
             accept_chart_gaps,
         )
-        manifest["parameters"]["domains"] = domains.value
-        manifest["parameters"]["vessel_tracks"] = vessel_tracks
-        manifest["slabs"] = {
-            "slab_s": params.replay.slab_s,
-            "slabs": len(slabs),
-            "workers": "scheduler " + scheduler if scheduler is not None else workers,
-            "pairs_followed_past_their_slab": sum(r.followed for r in results),
-        }
+        manifest["parameters"].update(domains=domains.value, vessel_tracks=vessel_tracks)
+        manifest["slabs"] = _slab_facts(params.replay.slab_s, len(slabs), scheduler or workers)
+        manifest["slabs"]["pairs_followed_past_their_slab"] = sum(r.followed for r in results)
         result = ReplayResult(
             query_name=query.name,
             out_dir=target,
@@ -335,11 +330,18 @@ def run_replay(
             files=(),
             vessel_tracks=tracks,
         )
-        files: tuple[Path, ...] = ()
-        if write:
-            with progress_bar("Reports", len(result.encounters), progress_enabled(quiet)) as bar:
-                files = runner.write_reports(result, chart, plots, bar, overwrite, domains)
+        if not write:
+            return dataclasses.replace(result, text=format_summary(result))
+        with progress_bar("Reports", len(result.encounters), progress_enabled(quiet)) as bar:
+            files = runner.write_reports(result, chart, plots, bar, overwrite, domains)
         return dataclasses.replace(result, files=files, text=format_summary(result))
+
+
+def _slab_facts(slab_s: float, slabs: int, where: str | int) -> dict[str, Any]:
+    """run.json's ``slabs``: their length and number, and the workers (a count, or the
+    scheduler's address)."""
+    workers = f"scheduler {where}" if isinstance(where, str) else where
+    return {"slab_s": slab_s, "slabs": slabs, "workers": workers}
 
 
 def _checked_options(workers: int, scratch_dir: Path | None, domains: Domains | str) -> Domains:

@@ -21,10 +21,10 @@ from ..core.ais_claims import NavStatusParams
 from ..core.audit import ConductParams
 from ..core.channel_audit import ChannelAuditParams
 from ..core.colregs import ColregsParams
-from ..core.encounters import EncounterParams
 from ..core.interactions import InteractionParams
 from ..core.manoeuvrability import ManoeuvrabilityParams
 from ..core.pair import PairParams
+from ..core.pair_search import EncounterParams
 from ..core.passing import PassingParams
 from ..core.rule9 import Rule9Params
 from ..core.tracks import TrackParams
