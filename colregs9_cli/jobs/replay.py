@@ -118,10 +118,10 @@ def run_frame(query: Query, extent: Extent, chart: ChartSource | None = None) ->
     charts, on the query region, else on the data (``slabs.Extent.frame``).
 
     The frame carries the chart, the manoeuvrability estimate and the figures; the geometry
-    between vessels never uses it (``encounters.py``), and the tracks are resampled on the
-    Earth, so a position beyond its reach only loses its frame coordinates. The charts come
-    first because a national query's centre may lie hundreds of kilometres from a harbour
-    cell, where the frame's scale would bend the ship domains.
+    between vessels never uses it (``pair_search.py``, ``encounters.py``), and the tracks are
+    resampled on the Earth, so a position beyond its reach only loses its frame coordinates.
+    The charts come first because a national query's centre may lie hundreds of kilometres
+    from a harbour cell, where the frame's scale would bend the ship domains.
     """
     if chart is not None:
         return LocalFrame.centred_on(*chart.bounds_wgs84())
