@@ -4,7 +4,7 @@ fairway" reads from the chart (``core.confinement.confined_to_channel`` judges i
 
 Through her position, square to the channel's local axis, the section is cut twice:
 
-- by the charted channel areas it meets (``Channels.areas_across``: fairways, dredged
+- by the charted channel areas it meets (``Channels.section_limits``: fairways, dredged
   areas, deep-water routes, traffic lanes and separation zones, joined, so that a cut
   charted as two one-way fairways, or a dredged centre between dredged toes, is one channel
   and the other half is not "room outside" it): its limits on her port and starboard hands;
@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .channels import Channels, section_extents, section_lines
+from .channels import Channels, section_extents
 from .water import Chart
 
 # A point this far past where the navigable water ends tells whether it ended inside the
@@ -82,11 +82,7 @@ def water_beyond_limits(
     radians = np.radians(bearing[q])
     right_unit = np.column_stack([np.cos(radians), -np.sin(radians)])
     centre = np.column_stack([east[q], north[q]])
-    channel_reach_m = (np.full(len(q), channels.reach_m),) * 2
-    areas = channels.areas_across(section_lines(centre, right_unit, channel_reach_m))
-    limit_port_m[q], limit_starboard_m[q] = section_extents(
-        centre, right_unit, channel_reach_m, areas
-    )
+    limit_port_m[q], limit_starboard_m[q] = channels.section_limits(centre, right_unit)
     inside = np.isfinite(limit_port_m[q] + limit_starboard_m[q])
     q, centre, right_unit = q[inside], centre[inside], right_unit[inside]
     # Past each limit by the room asked and a metre, so that water reaching that far is open.

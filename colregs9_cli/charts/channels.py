@@ -64,6 +64,8 @@ KIND_PRECEDENCE = (
 _WINDOW_OF_WIDTH = 0.5
 _MIN_WINDOW_M = 10.0
 _LINE_TYPES = (shapely.GeometryType.LINESTRING, shapely.GeometryType.MULTILINESTRING)
+# Channel areas whose sections end within this of each other share an edge: one channel.
+_TOUCHING_M = 1e-3
 
 
 class Traffic(StrEnum):
@@ -295,21 +297,39 @@ class Channels:
     def __getitem__(self, index: int) -> Channel:
         return self.items[index]
 
-    @property
-    def reach_m(self) -> float:
-        """The longest extent of any channel (the diagonal of its bounds, and a metre): a
-        section that long either side of a position crosses the channel areas it is in."""
-        return float(self._reach_m.max(initial=1.0))
-
-    def areas_across(self, lines: NDArray[np.object_]) -> NDArray[np.object_]:
-        """For each line, the channel areas it meets joined into one geometry (empty where
-        it meets none): side by side, they are one channel to be confined to."""
-        line_index, area_rank = self._tree.query(lines, predicate="intersects")
-        joined = np.asarray(shapely.from_wkt(["POLYGON EMPTY"] * len(lines)), dtype=object)
-        geometries = np.asarray([self.items[i].geometry for i in self._areas], dtype=object)
-        for line in np.unique(line_index).tolist():
-            joined[line] = shapely.union_all(geometries[area_rank[line_index == line]])
-        return joined
+    def section_limits(
+        self, centre_xy: NDArray[np.float64], right_unit: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """For each point (x = east, y = north) and the unit vector to its right, how far to
+        its left and to its right the channel areas run along the line square to its
+        direction, the areas it meets side by side joined (a cut charted as two one-way
+        fairways, a dredged centre between dredged toes: one channel to be confined to).
+        NaN where the point is in no channel area."""
+        left, right = np.full(len(centre_xy), np.nan), np.full(len(centre_xy), np.nan)
+        reach = np.full(len(centre_xy), float(self._reach_m.max(initial=1.0)))
+        lines = section_lines(centre_xy, right_unit, (reach, reach))
+        line_of_pair, area_rank = self._tree.query(lines, predicate="intersects")
+        areas = np.asarray([self.items[i].geometry for i in self._areas], dtype=object)
+        pieces, pair = shapely.get_parts(
+            shapely.intersection(lines[line_of_pair], areas[area_rank]), return_index=True
+        )
+        straight = np.isin(shapely.get_type_id(pieces), _LINE_TYPES)
+        pieces, line = pieces[straight], line_of_pair[pair[straight]]
+        ends = np.stack(
+            [
+                shapely.get_coordinates(shapely.get_point(pieces, 0)),
+                shapely.get_coordinates(shapely.get_point(pieces, -1)),
+            ],
+            axis=1,
+        )
+        along = np.einsum("kij,kj->ki", ends - centre_xy[line][:, None, :], right_unit[line])
+        starts_m, stops_m = along.min(axis=1), along.max(axis=1)
+        for point in np.unique(line).tolist():
+            mine = line == point
+            span = _span_holding_zero(starts_m[mine], stops_m[mine])
+            if span is not None:
+                left[point], right[point] = max(-span[0], 0.0), max(span[1], 0.0)
+        return left, right
 
     def labels(self, index: ArrayLike) -> list[str | None]:
         """The label of each indexed channel, None for -1."""
@@ -516,6 +536,25 @@ def section_extents(
     right[owner[first]] = np.maximum(along[first].max(axis=1), 0.0)
     left[owner[first]] = np.maximum(-along[first].min(axis=1), 0.0)
     return left, right
+
+
+def _span_holding_zero(
+    starts_m: NDArray[np.float64], stops_m: NDArray[np.float64]
+) -> tuple[float, float] | None:
+    """Of the intervals ``starts_m[i]..stops_m[i]`` along a line, joined where they touch
+    (areas sharing an edge, to ``_TOUCHING_M``), the span that holds 0; None where none
+    does."""
+    order = np.argsort(starts_m)
+    spans: list[list[float]] = []
+    for start_m, stop_m in zip(starts_m[order].tolist(), stops_m[order].tolist(), strict=True):
+        if spans and start_m <= spans[-1][1] + _TOUCHING_M:
+            spans[-1][1] = max(spans[-1][1], stop_m)
+        else:
+            spans.append([start_m, stop_m])
+    for start_m, stop_m in spans:
+        if start_m <= _TOUCHING_M and stop_m >= -_TOUCHING_M:
+            return start_m, stop_m
+    return None
 
 
 def _points_xy(
