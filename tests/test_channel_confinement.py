@@ -455,3 +455,21 @@ def test_the_confinement_is_the_same_for_any_slab_length(tmp_path: Path) -> None
     ]
     assert tables[0]["confined_to_channel_a"].tolist() == ["true"]
     pd.testing.assert_frame_equal(tables[0], tables[1])
+
+
+@pytest.mark.parametrize(("neighbour_west_m", "right_m"), [(100.0, 300.0), (150.0, 100.0)])
+def test_channel_areas_are_joined_only_where_they_touch(
+    tmp_path: Path, neighbour_west_m: float, right_m: float
+) -> None:
+    # A fairway from x -100 to 100 and another from neighbour_west_m to 300: sharing an edge
+    # they are one channel; 50 m apart, two.
+    _, channels = _cut_chart(
+        tmp_path,
+        ({"OBJL": "FAIRWY", "OBJNAM": "A"}, shapely.box(-100, -3000, 100, 3000)),
+        ({"OBJL": "FAIRWY", "OBJNAM": "B"}, shapely.box(neighbour_west_m, -3000, 300, 3000)),
+    )
+    northbound = np.array([[1.0, 0.0]])  # her right hand is east
+    left, right = channels.section_limits(np.array([[0.0, 0.0]]), northbound)
+    np.testing.assert_allclose([left[0], right[0]], [100.0, right_m], atol=1e-6)
+    outside = channels.section_limits(np.array([[-500.0, 0.0]]), northbound)
+    assert np.isnan(outside[0][0]) and np.isnan(outside[1][0])
