@@ -473,3 +473,30 @@ def test_channel_areas_are_joined_only_where_they_touch(
     np.testing.assert_allclose([left[0], right[0]], [100.0, right_m], atol=1e-6)
     outside = channels.section_limits(np.array([[-500.0, 0.0]]), northbound)
     assert np.isnan(outside[0][0]) and np.isnan(outside[1][0])
+
+
+def test_iris_ace_is_confined_to_the_san_diego_entrance_channel(
+    sandiego: tuple[Any, Channels, int],
+) -> None:
+    """The fixture's one large vessel under way: the car carrier IRIS ACE (187 m, 8.7 m
+    draught) inbound along the entrance channel at both her reports (README)."""
+    from colregs9_cli.charts.channel_facts import channel_facts
+
+    from fixture_files import SANDIEGO_AIS
+
+    chart, channels, index = sandiego
+    rows = pd.read_csv(SANDIEGO_AIS)
+    iris = rows[rows["MMSI"] == 319392000].sort_values("BaseDateTime")
+    assert (iris["Length"] == 187).all() and (iris["Draft"] == 8.7).all()
+    lat, lon = iris["LAT"].to_numpy(), iris["LON"].to_numpy()
+    north, east = channels.frame.to_local(lat, lon)
+    course = channels.frame.true_to_grid_deg(iris["COG"].to_numpy(), lat, lon)
+    facts = channel_facts(channels, north, east, course)
+    assert facts.channel.tolist() == [index, index]
+    assert list(facts.relation) == [ChannelRelation.ALONG] * 2
+    water = water_beyond_limits(channels, chart, north, east, facts.axis_grid_deg, 8.7, 0.0, 187.0)
+    np.testing.assert_allclose(water.port_m, [12.0, 0.0], atol=1.0)
+    np.testing.assert_allclose(water.starboard_m, [32.0, 41.0], atol=1.0)
+    np.testing.assert_allclose(water.navigable_width_m, [211.0, 183.0], atol=1.0)
+    assert (water.port_m < 187.0).all() and (water.starboard_m < 187.0).all()
+    assert (water.navigable_width_m < 5 * 187.0).all()
