@@ -7,9 +7,10 @@
     result = colregs9.replay(["day.nmea.gz"], charts=["cell.000"])    # nothing written
     result.pairs, result.encounters, result.tracks                     # DataFrames
 
-Paths may be strings. Errors are ``Colregs9Error`` (here, and its subclasses) with the
-message the command line prints. Importing this module changes nothing in the process: no
-matplotlib backend, no signal handler (those are the console script's, ``cli.run``).
+Paths may be strings, and one path may be given alone. Errors are ``Colregs9Error`` (here,
+and its subclasses) with the message the command line prints. Importing this module changes
+nothing in the process: no matplotlib backend, no signal handler (those are the console
+script's, ``cli.run``).
 """
 
 from __future__ import annotations
@@ -52,14 +53,30 @@ __all__ = [
 PathLike = str | Path
 
 
-def read_ais(paths: Sequence[PathLike], query: PathLike | None = None) -> pd.DataFrame:
+def _paths(paths: PathLike | Sequence[PathLike]) -> list[Path]:
+    """One path or several, as paths (a string is one path, not a sequence of letters)."""
+    return [Path(paths)] if isinstance(paths, str | Path) else [Path(p) for p in paths]
+
+
+def _mmsis(own_mmsi: int | Sequence[int]) -> list[int]:
+    """One own-ship MMSI or several, as integers; anything else is a ``ParameterError``."""
+    try:
+        given = [own_mmsi] if isinstance(own_mmsi, int | str) else list(own_mmsi)
+        return [int(m) for m in given]
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"own_mmsi = {own_mmsi!r}: give an MMSI (9 digits) or a list of them"
+        ) from None
+
+
+def read_ais(paths: PathLike | Sequence[PathLike], query: PathLike | None = None) -> pd.DataFrame:
     """Cleaned positions in the canonical schema, selected by the query (a TOML file)."""
     selected = load_query(Path(query)) if query is not None else everything_query()
-    return load_ais([Path(p) for p in paths], query=selected).positions
+    return load_ais(_paths(paths), query=selected).positions
 
 
 def vessel_stats(
-    paths: Sequence[PathLike],
+    paths: PathLike | Sequence[PathLike],
     query: PathLike | None = None,
     per: str = "vessel",
     by: str | None = None,
@@ -73,7 +90,7 @@ def vessel_stats(
             f"{exc}; per is one of {[p.value for p in Per]}, by one of "
             f"{[b.value for b in GroupBy]} or None"
         ) from None
-    data = count_ais([Path(p) for p in paths], query=selected)
+    data = count_ais(_paths(paths), query=selected)
     return dimension_stats(
         data.position_counts, data.dimension_reports, per=per_choice, by=by_choice
     ).to_frame()
@@ -122,19 +139,19 @@ class Replay:
 
 
 def replay(
-    paths: Sequence[PathLike],
-    charts: Sequence[PathLike] = (),
+    paths: PathLike | Sequence[PathLike],
+    charts: PathLike | Sequence[PathLike] = (),
     query: PathLike | None = None,
-    own_mmsi: Sequence[int] = (),
+    own_mmsi: int | Sequence[int] = (),
 ) -> Replay:
     """The replay of ``colregs9 replay``, in memory (nothing is written): its pairs,
     encounters and tracks as DataFrames (``Replay``)."""
     return Replay.of(
         run_replay(
-            [Path(p) for p in paths],
-            chart_paths=[Path(c) for c in charts],
+            _paths(paths),
+            chart_paths=_paths(charts),
             query_path=None if query is None else Path(query),
-            own_mmsi=own_mmsi,
+            own_mmsi=_mmsis(own_mmsi),
             plots=False,
             write=False,
         )

@@ -264,7 +264,8 @@ def check_out_dir(
     """Refuse, before any work, an ``--out`` that cannot take a report of ``command``: a file,
     a directory under a file, one without write access, the current, a parent or the home
     directory (the report replaces its directory), one that is or holds one of the run's
-    ``inputs``, or a dataset of ``colregs9 ingest`` (all these even with ``overwrite``); and,
+    ``inputs``, or a dataset of ``colregs9 ingest`` or a directory inside one (all these even
+    with ``overwrite``); and,
     unless ``overwrite``, a colregs9 report of another command, or a directory that holds
     files colregs9 did not write there (those its run.json does not list; all of them where
     there is no run.json), naming the first few. With ``overwrite`` the report replaces the
@@ -299,6 +300,12 @@ def check_out_dir(
             raise OutputError(
                 f"{out_dir}: --out is or holds the input {given}, which the report would "
                 "replace; give another directory for the report"
+            )
+    for above in resolved.parents:
+        if (above / DATASET_MARKER).exists():
+            raise OutputError(
+                f"{out_dir}: --out lies inside {above}, a dataset of colregs9 ingest, which "
+                "holds its own files only; give a directory outside it for the report"
             )
     if out_dir.is_dir():
         _check_what_is_there(out_dir, overwrite, command)

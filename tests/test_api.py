@@ -51,6 +51,17 @@ def test_api_results_match_the_commands() -> None:
         colregs9.vessel_stats([DMA26], per="ship")
 
 
+def test_one_path_may_be_given_alone_and_a_bad_mmsi_is_one_error() -> None:
+    """A string is one path, not a sequence of one-letter paths; own_mmsi takes one MMSI or
+    a list, and anything else is the API's ParameterError."""
+    alone = colregs9.read_ais(str(DMA26))
+    pd.testing.assert_frame_equal(alone, colregs9.read_ais([DMA26]))
+    assert colregs9.vessel_stats(DMA26).equals(colregs9.vessel_stats([str(DMA26)]))
+    for bad in (["abc"], 1.5j, [None]):
+        with pytest.raises(colregs9.ParameterError, match=r"own_mmsi = .*give an MMSI"):
+            colregs9.replay(DMA26, own_mmsi=bad)  # type: ignore[arg-type]
+
+
 def test_the_error_classes_are_the_apis_and_bad_input_raises_them(tmp_path: Path) -> None:
     assert colregs9.Colregs9Error is errors.Colregs9Error
     exported = {name for name in colregs9.__all__ if name.endswith("Error")}

@@ -219,6 +219,15 @@ def test_missing_and_unknown_files(tmp_path: Path) -> None:
     other.write_bytes(b"PK")
     with pytest.raises(ChartError, match="unknown chart type"):
         load_chart([other])
+    for name in ("broken.geojson", "fake.gpkg"):
+        (tmp_path / name).write_text("{nope")
+        with pytest.raises(ChartError, match="not a chart GDAL can open") as raised:
+            load_chart([tmp_path / name])
+        assert "DRIVER" not in str(raised.value)  # GDAL's hint: colregs9 takes no prefix
+    update = tmp_path / "US5CA72M.002"
+    update.write_bytes(b"")
+    with pytest.raises(ChartError, match=r"an S-57 update file \(\.002\); give its base cell"):
+        load_chart([update])
 
 
 def test_draw_chart_shades_depth_areas_by_drval1(enc: Chart) -> None:

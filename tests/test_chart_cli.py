@@ -136,6 +136,15 @@ def test_an_out_ending_in_a_separator_names_a_directory(tmp_path: Path, name: st
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("name", ["plots", "plots.png"])
+def test_an_out_that_is_a_directory_is_named_so(tmp_path: Path, name: str) -> None:
+    (tmp_path / name).mkdir()
+    result = _run("chart", str(ENC), "--draught", "5", "--out", str(tmp_path / name), "--quiet")
+    _one_error_line(result, name, "--out is a directory")
+    assert result.exit_code == 2
+    assert list((tmp_path / name).iterdir()) == []
+
+
 def test_an_out_under_a_file_is_refused(tmp_path: Path) -> None:
     (tmp_path / "file").write_text("x")
     result = _run("chart", str(ENC), "--draught", "5", "--out", str(tmp_path / "file" / "c.gpkg"))

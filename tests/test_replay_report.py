@@ -128,6 +128,7 @@ def test_index_links_resolve(run) -> None:
     assert f"encounters/{encounter_id}.csv" in links
     assert f"encounters/{encounter_id}.png" in links
     assert "encounters.csv" in links and "run.json" in links and "pairs.csv" in links
+    assert "report.gpkg" in links and "every vessel's track" in text
     for link in links:
         assert (run.out_dir / link).is_file(), link
 

@@ -159,6 +159,10 @@ def test_a_dataset_never_takes_a_report(tmp_path: Path) -> None:
     for overwrite in (False, True):
         with pytest.raises(OutputError, match="is a dataset of colregs9 ingest"):
             check_out_dir(out, overwrite, command="replay")
+        # Nor does a directory inside it, new or already there.
+        for inside in (out / "report", out / "date=2024-09-09" / "report"):
+            with pytest.raises(OutputError, match=r"lies inside .*, a dataset of colregs9 ingest"):
+                check_out_dir(inside, overwrite, command="replay")
 
 
 def test_a_file_of_a_report_is_not_an_out_file(tmp_path: Path) -> None:

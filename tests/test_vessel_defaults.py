@@ -7,6 +7,7 @@ import math
 import pytest
 
 from colregs9_cli.core.vessel_defaults import DIMENSIONS, default_table, vessel_dimensions
+from colregs9_cli.errors import ParameterError
 from colregs9_cli.jobs.replay_params import ReplayParams
 
 
@@ -52,6 +53,21 @@ def test_query_overrides_replace_the_table() -> None:
     dims = vessel_dimensions({"mobile_type": "Class B", "length_m": 10.0}, overrides)
     assert (dims.length_m, dims.breadth_m, dims.draught_m) == (10.0, 4.0, 4.5)
     assert "override" in dims.basis
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("default_length_m", 10_000.0),
+        ("default_breadth_m", 1e9),
+        ("default_draught_m", 100.0),
+        ("default_length_m", 0.0),
+    ],
+)
+def test_query_overrides_beyond_a_ship_are_one_error(name: str, value: float) -> None:
+    with pytest.raises(ParameterError, match=f"{name} = {value!r}: give a number above 0"):
+        ReplayParams(**{name: value})
+    assert ReplayParams(**{name: 20.0 if name != "default_length_m" else 500.0})
 
 
 def test_the_table_is_complete_and_plausible() -> None:

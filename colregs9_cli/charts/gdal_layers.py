@@ -80,8 +80,14 @@ def _check_finite(
 
 
 def first_line(exc: BaseException) -> str:
-    """The first line of an exception's message (GDAL's run to several), for an error."""
-    return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    """The first line of an exception's message (GDAL's run to several), for an error,
+    without GDAL's hint to prefix the path with a driver's name, which colregs9 does not
+    take."""
+    text = str(exc).strip()
+    if not text:
+        return type(exc).__name__
+    line = text.splitlines()[0]
+    return line.split("; It might help to specify the correct driver", 1)[0].rstrip(" .;")
 
 
 def list_layers(path: Path) -> list[str]:

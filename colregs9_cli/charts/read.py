@@ -313,6 +313,11 @@ def read_features(path: Path) -> Features:
         features = _read_s57(path)
     elif suffix in VECTOR_SUFFIXES:
         features = _read_vector(path)
+    elif len(suffix) == 4 and suffix[1:].isdigit():
+        raise ChartError(
+            f"{path}: an S-57 update file ({suffix}); give its base cell "
+            f"({path.with_suffix('.000').name}), whose update files beside it are applied"
+        )
     else:
         raise ChartError(
             f"{path}: unknown chart type {suffix or '(no suffix)'!r}; give an S-57 base cell "

@@ -143,8 +143,8 @@ def confined_to_channel(
         f"for {depth} reaches a median {_room(port_m[known], within_m)} beyond its port-hand "
         f"limit and {_room(starboard_m[known], within_m)} beyond its starboard-hand limit, "
         f"the channel {np.nanmedian(width_m[known]):.0f} m wide for her (confined: under "
-        f"{within_m:.0f} m beyond both, {params.within_lengths:g}× her length, in a channel "
-        f"under {narrow_m:.0f} m, {params.narrow_within_lengths:g}× her length)"
+        f"{_metres(within_m)} beyond both, {params.within_lengths:g}× her length, in a channel "
+        f"under {_metres(narrow_m)}, {params.narrow_within_lengths:g}× her length)"
     )
     return ConfinedToChannel(Fact.of(2 * int(shut.sum()) > judged), basis)
 
@@ -154,4 +154,10 @@ def _room(beyond_m: np.ndarray, within_m: float) -> str:
     if not np.isfinite(beyond_m).any():
         return "(to the chart's edge)"
     median_m = float(np.nanmedian(beyond_m))
-    return f"{within_m:.0f} m or more" if median_m >= within_m else f"{median_m:.0f} m"
+    return f"{_metres(within_m)} or more" if median_m >= within_m else _metres(median_m)
+
+
+def _metres(value_m: float) -> str:
+    """A distance as the basis gives it: to the metre, or to two figures under 10 m (a
+    threshold of a small fraction of her length is not "0 m")."""
+    return f"{value_m:.0f} m" if value_m >= 10.0 else f"{value_m:.2g} m"

@@ -310,6 +310,11 @@ def check_chart_out(out: Path | None, draught_m: float | None) -> None:
             "water for a draught; add --draught"
         )
     suffix = out.suffix.lower()
+    if out.is_dir():
+        raise OutputError(
+            f"{out}: --out is a directory; give a file in it, FILE.gpkg for a GeoPackage or "
+            f"FILE.png ({', '.join(PLOT_SUFFIXES)}) for a plot"
+        )
     if suffix != GEOPACKAGE_SUFFIX and suffix not in PLOT_SUFFIXES:
         raise OutputError(
             f"{out}: --out ends in {suffix or '(no suffix)'!r}, which the chart command does not "

@@ -30,6 +30,7 @@ from ..core.rule9 import Rule9Params
 from ..core.tracks import TrackParams
 from ..core.vessel_defaults import DimensionDefaults
 from ..errors import ParameterError
+from ..vessels import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
 
 T = TypeVar("T")
 
@@ -180,12 +181,16 @@ class ReplayParams:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0.0):
                 raise ParameterError(f"[replay] {name} = {value!r}: give a positive number")
-        for name in ("default_length_m", "default_breadth_m", "default_draught_m"):
+        for name, most_m in (
+            ("default_length_m", MAX_LENGTH_M),
+            ("default_breadth_m", MAX_BREADTH_M),
+            ("default_draught_m", MAX_DRAUGHT_M),
+        ):
             value = getattr(self, name)
-            if value is not None and not (math.isfinite(value) and value > 0.0):
+            if value is not None and not (math.isfinite(value) and 0.0 < value <= most_m):
                 raise ParameterError(
-                    f"[replay] {name} = {value!r}: give a positive number, or leave it out to "
-                    "take defaults by ship type"
+                    f"[replay] {name} = {value!r}: give a number above 0 and at most "
+                    f"{most_m:g} (a ship's), or leave it out to take defaults by ship type"
                 )
         for name in (
             "min_sog_kn",

@@ -187,6 +187,17 @@ def format_index(result: ReplayResult, plots: bool) -> str:
         f"- [{MANIFEST_NAME}]({MANIFEST_NAME}): inputs, parameters, rejects ledger and counts.",
         f"- [{HTML_NAME}]({HTML_NAME}): this report as a web page, with a map and a table "
         "to sort and filter.",
+        *(
+            [
+                f"- [{GEOPACKAGE_NAME}]({GEOPACKAGE_NAME}): the encounters, their tracks, "
+                "positions at TCPA and ship domains"
+                + (", every vessel's track" if result.vessel_tracks.size else "")
+                + " and, with a chart, the navigable water and the channels used, in WGS84 "
+                "with QGIS styles."
+            ]
+            if result.encounters
+            else []
+        ),
         "",
     ]
     if not result.pairs:
