@@ -289,6 +289,13 @@ class Query:
         state["tables"] = {key: dict(table) for key, table in self.tables.items()}
         return (_unpickled_query, (state,))
 
+    @property
+    def has_replay_tables(self) -> bool:
+        """Whether the query holds a table of the replay's stages, which a command that does
+        not use it still checks (``jobs.replay_params.stage_tables``), so that a query one
+        command accepts, the others accept."""
+        return any(name in self.tables for name in ("replay", "colregs", "manoeuvrability"))
+
     def frame(self) -> LocalFrame | None:
         """The run's local metric frame, centred on the region's box; None without a region."""
         # pyproj is imported here, by the commands that project, not by every read.

@@ -458,3 +458,29 @@ def test_histograms_by_ship_type_plot_each_type_in_one_colour(tmp_path: Path) ->
         panels[dimension] = set(plotted)
     # The case that shifted the colours: a type with a length but no draught.
     assert panels["length_m"] - panels["draught_m"] == {"SAR"}
+
+
+@pytest.mark.parametrize(
+    ("table", "message"),
+    [
+        ("[replay]\nfoo = 1\n", "[replay]: unknown key 'foo'"),
+        ("[replay]\nchannel_narrow_within_lengths = -5\n", "channel_narrow_within_lengths"),
+        ("[manoeuvrability]\nalpha = 2.0\n", "alpha 2.0 is outside [0, 1]"),
+    ],
+)
+@pytest.mark.parametrize("command", ["stats", "ingest"])
+def test_a_query_stats_accepts_replay_accepts(
+    tmp_path: Path, command: str, table: str, message: str
+) -> None:
+    """stats and ingest do not use the replay's tables, but check them, so that a query
+    they accept is one replay accepts."""
+    query = tmp_path / "q.toml"
+    query.write_text(table)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(
+        app, [command, str(DMA26), "--query", str(query), "--out", str(out), "--quiet"]
+    )
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("Error: ") and message in lines[0]
+    assert not out.exists()

@@ -165,6 +165,10 @@ def ingest(
     any input is read.
     """
     query = load_query(query_path) if query_path is not None else everything_query()
+    if query.has_replay_tables:
+        from .replay_params import stage_tables
+
+        stage_tables(query)
     return ingest_with_query(paths, out_dir, query, fmt, quiet, row_group_rows, refuse_empty=True)
 
 

@@ -36,9 +36,7 @@ from ..charts.channels import Channels, load_channels
 from ..charts.provenance import charts_manifest
 from ..charts.sources import ChartSource, read_charts
 from ..charts.water import Chart, project_charts
-from ..core.colregs import colregs_params_from_table
 from ..core.encounters import Encounter, check_own_mmsi
-from ..core.manoeuvrability import ManoeuvrabilityParams
 from ..core.pair import PairParams, evaluate_pair
 from ..core.replay_results import (
     PairOutcome,
@@ -58,7 +56,7 @@ from ..report.replay_geopackage import Domains
 from ..report.replay_report import format_summary
 from .executor import executor
 from .replay_input import open_replay_input, segment_input_part
-from .replay_params import ReplayParams, ReplayRunParams, replay_params_from_table
+from .replay_params import ReplayParams, ReplayRunParams, stage_tables
 from .slabs import (
     Extent,
     PairEvaluator,
@@ -86,13 +84,7 @@ def run_params(
     ``overrides`` maps a table name (``replay``, ``colregs``, ``manoeuvrability``) to the
     values given on the command line; each is validated by its dataclass.
     """
-    where = f"{query.source if query.source is not None else 'query'}"
-    tables = query.tables
-    replay = replay_params_from_table(dict(tables.get("replay", {})), f"{where} [replay]")
-    colregs = colregs_params_from_table(dict(tables.get("colregs", {})), f"{where} [colregs]")
-    manoeuvrability = ManoeuvrabilityParams.from_table(
-        dict(tables.get("manoeuvrability", {})), f"{where} [manoeuvrability]"
-    )
+    replay, colregs, manoeuvrability = stage_tables(query)
     given = {
         table: {k: v for k, v in values.items() if v is not None}
         for table, values in (overrides or {}).items()

@@ -20,7 +20,7 @@ from ..config import dataclass_from_table
 from ..core.ais_claims import NavStatusParams
 from ..core.audit import ConductParams
 from ..core.channel_audit import ChannelAuditParams
-from ..core.colregs import ColregsParams
+from ..core.colregs import ColregsParams, colregs_params_from_table
 from ..core.interactions import InteractionParams
 from ..core.manoeuvrability import ManoeuvrabilityParams
 from ..core.pair import PairParams
@@ -30,6 +30,7 @@ from ..core.rule9 import Rule9Params
 from ..core.tracks import TrackParams
 from ..core.vessel_defaults import DimensionDefaults
 from ..errors import ParameterError
+from ..query import Query
 from ..vessels import MAX_BREADTH_M, MAX_DRAUGHT_M, MAX_LENGTH_M
 
 T = TypeVar("T")
@@ -259,6 +260,20 @@ def replay_params_from_table(table: dict[str, Any], where: str) -> ReplayParams:
 
 
 REPLAY_KEYS: tuple[str, ...] = tuple(f.name for f in fields(ReplayParams))
+
+
+def stage_tables(query: Query) -> tuple[ReplayParams, ColregsParams, ManoeuvrabilityParams]:
+    """The query's ``[replay]``, ``[colregs]`` and ``[manoeuvrability]`` tables, each
+    checked by its dataclass (a ``QueryError`` or ``ParameterError`` names the key)."""
+    where = f"{query.source if query.source is not None else 'query'}"
+    tables = query.tables
+    return (
+        replay_params_from_table(dict(tables.get("replay", {})), f"{where} [replay]"),
+        colregs_params_from_table(dict(tables.get("colregs", {})), f"{where} [colregs]"),
+        ManoeuvrabilityParams.from_table(
+            dict(tables.get("manoeuvrability", {})), f"{where} [manoeuvrability]"
+        ),
+    )
 
 
 @dataclass(frozen=True)

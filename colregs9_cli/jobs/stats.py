@@ -67,6 +67,10 @@ def run_stats(
         from ..query import everything_query, load_query
 
         query = load_query(query_path) if query_path is not None else everything_query()
+        if query.has_replay_tables:
+            from .replay_params import stage_tables
+
+            stage_tables(query)
         from ..outputs import check_out_dir
 
         target = Path(out_dir) if out_dir is not None else default_out_dir(query.name)
