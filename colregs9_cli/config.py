@@ -16,7 +16,7 @@ import typing
 from pathlib import Path
 from typing import Any, TypeVar
 
-from .errors import InputFileError, ParameterError, QueryError
+from .errors import InputFileError, ParameterError, QueryError, input_status
 
 T = TypeVar("T")
 # tomllib parses nested arrays and inline tables recursively, so hundreds of levels exhaust
@@ -29,14 +29,7 @@ TOO_DEEP = (
 
 def read_toml(path: Path) -> dict[str, Any]:
     """Read a TOML file; a missing file or a syntax error becomes one clear error."""
-    try:
-        status = path.stat()
-    except FileNotFoundError:
-        raise InputFileError(f"{path}: no such file; check the path") from None
-    except OSError as exc:  # a symbolic link that loops, a name too long, a file on the way
-        raise InputFileError(
-            f"{path}: cannot open it ({exc.strerror}); check the path and its symbolic links"
-        ) from None
+    status = input_status(path)
     if stat.S_ISDIR(status.st_mode):
         raise InputFileError(f"{path}: a directory, not a file; give the TOML file")
     if not stat.S_ISREG(status.st_mode):  # reading a pipe would wait for a writer

@@ -5,6 +5,9 @@ Messages name the file, line or column, the bad value, and what to do about it.
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 
 class Colregs9Error(Exception):
     """Base class for every error caused by the user's input or environment."""
@@ -46,3 +49,17 @@ class NoDataError(Colregs9Error):
     """The input is valid but the query selects nothing to work on."""
 
     exit_code = 3
+
+
+def input_status(path: Path) -> os.stat_result:
+    """``path.stat()`` of an input the user named, its failures one ``InputFileError``: a
+    missing file, or one that cannot be reached (a symbolic link that loops, a name too long,
+    a file on the way)."""
+    try:
+        return path.stat()
+    except FileNotFoundError:
+        raise InputFileError(f"{path}: no such file; check the path") from None
+    except OSError as exc:
+        raise InputFileError(
+            f"{path}: cannot open it ({exc.strerror}); check the path and its symbolic links"
+        ) from None

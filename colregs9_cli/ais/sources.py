@@ -27,7 +27,7 @@ from typing import BinaryIO
 
 import pyarrow as pa
 
-from ..errors import InputFileError
+from ..errors import InputFileError, input_status
 from ..progress import ProgressSink
 
 GZIP_MAGIC = b"\x1f\x8b"
@@ -71,14 +71,7 @@ class Source:
 def inspect_source(path: Path) -> Source:
     """Check that ``path`` is a readable, non-empty file and find its compression."""
     path = Path(path)
-    try:
-        status = path.stat()
-    except FileNotFoundError:
-        raise InputFileError(f"{path}: no such file; check the path") from None
-    except OSError as exc:  # a symbolic link that loops, a name too long, a file on the way
-        raise InputFileError(
-            f"{path}: cannot open it ({exc.strerror}); check the path and its symbolic links"
-        ) from None
+    status = input_status(path)
     if stat.S_ISDIR(status.st_mode):
         raise InputFileError(f"{path}: not a file; give AIS files, not a directory")
     if not stat.S_ISREG(status.st_mode):
