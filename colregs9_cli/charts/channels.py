@@ -38,14 +38,13 @@ import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import ChartError, ParameterError
+from ..errors import ParameterError
 from ..geo import LocalFrame
 from ..units import wrap_deg
 from .channel_axis import centreline, orient_axis
 from .channel_read import ChannelFeatures, read_channel_features
-from .gdal_layers import first_line
 from .s57_classes import AREA_CHANNEL_KINDS, CHANNEL_CLASSES, POLYGONAL, ChannelKind
-from .sources import project, same_dimension
+from .sources import project_file, same_dimension
 from .water import Chart
 
 # A track runs along an area channel when its direction stays within this of the area's
@@ -626,23 +625,19 @@ def _read_channels(chart: Chart) -> Channels:
         features = read_channel_features(path)
         if len(features.geometries) == 0:
             continue
-        geometries = _projected(features, chart.frame)
+        geometries = project_file(
+            features.path,
+            features.geometries,
+            chart.frame,
+            what="channel",
+            fix="its rings or lines (lon/lat in degrees)",
+        )
         if several:
             own = chart.coverage_by_chart[rank]
             geometries = same_dimension(shapely.intersection(geometries, own), geometries)
         items.extend(_channels_of(features, geometries, chart.frame))
     channels = Channels(chart.frame, tuple(items), chart)
     return Channels(chart.frame, _with_tracks(channels), chart)
-
-
-def _projected(features: ChannelFeatures, frame: LocalFrame) -> Any:
-    try:
-        return project(features.geometries, frame)
-    except shapely.errors.GEOSException as exc:
-        raise ChartError(
-            f"{features.path}: a channel's geometry cannot be used ({first_line(exc)}); fix "
-            "its rings or lines (lon/lat in degrees)"
-        ) from None
 
 
 def _channels_of(

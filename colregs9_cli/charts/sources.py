@@ -113,14 +113,20 @@ def project(geometries: NDArray[np.object_], frame: LocalFrame) -> Any:
     return projected
 
 
-def _project_file(features: Features, frame: LocalFrame) -> Any:
-    """A file's features in the frame; a geometry GEOS cannot repair names the file."""
+def project_file(
+    path: Path,
+    geometries: Any,
+    frame: LocalFrame,
+    what: str = "feature",
+    fix: str = "its rings (closed, at least three distinct vertices, lon/lat in degrees)",
+) -> Any:
+    """A file's geometries in the frame; one GEOS cannot repair names the file, what it is
+    and what to fix."""
     try:
-        return project(features.geometries, frame)
+        return project(geometries, frame)
     except shapely.errors.GEOSException as exc:
         raise ChartError(
-            f"{features.path}: a feature's geometry cannot be used ({first_line(exc)}); fix "
-            "its rings (closed, at least three distinct vertices, lon/lat in degrees)"
+            f"{path}: a {what}'s geometry cannot be used ({first_line(exc)}); fix {fix}"
         ) from None
 
 
@@ -141,7 +147,7 @@ def claimed_by_detail(
 ) -> tuple[list[NDArray[np.object_]], list[Any]]:
     """Each file's projected geometries, cut to where no more detailed file has coverage (a
     coarse cell decides only outside the detailed one), and each file's coverage left."""
-    projected = [_project_file(f, frame) for f in features]
+    projected = [project_file(f.path, f.geometries, frame) for f in features]
     coverages = [_file_coverage(f, g, frame) for f, g in zip(features, projected, strict=True)]
     if len(features) == 1:
         return projected, coverages
