@@ -184,13 +184,19 @@ def test_domains_all_restricted_or_none(sandiego_replay, tmp_path: Path) -> None
     assert "domains" not in _layers(none) and "vessel_tracks" in _layers(none)
 
 
+def _style(path: Path, layer: str) -> str:
+    """The QML of a layer's default style in the GeoPackage's layer_styles table."""
+    with sqlite3.connect(path) as db:
+        (qml,) = db.execute(
+            "SELECT styleQML FROM layer_styles WHERE f_table_name = ?", (layer,)
+        ).fetchone()
+    return str(qml)
+
+
 def test_vessel_tracks_carry_a_temporal_style(nmea_report) -> None:
     """QGIS's default style of vessel_tracks sets the Temporal Controller to the start and
     end fields and draws the position at the frame's time from the M values."""
-    with sqlite3.connect(nmea_report.out_dir / "report.gpkg") as db:
-        (qml,) = db.execute(
-            "SELECT styleQML FROM layer_styles WHERE f_table_name = 'vessel_tracks'"
-        ).fetchone()
+    qml = _style(nmea_report.out_dir / "report.gpkg", "vessel_tracks")
     assert '<temporal enabled="1" mode="2" startField="start_utc" endField="end_utc"' in qml
     assert 'limitMode="0"' in qml
     assert "GeometryGenerator" in qml and "epoch(@map_end_time)" in qml
@@ -200,10 +206,7 @@ def test_lone_reports_show_in_the_frame_that_begins_at_them(nmea_report) -> None
     """A lone report starts where it ends: with QGIS's limit mode 0 (a frame shows the
     features whose end is after its beginning) it would show in no frame; its style keeps
     the end in (mode 1: QGIS 3.22 then filters ``"end_utc" >= <frame begin>``)."""
-    with sqlite3.connect(nmea_report.out_dir / "report.gpkg") as db:
-        (qml,) = db.execute(
-            "SELECT styleQML FROM layer_styles WHERE f_table_name = 'lone_reports'"
-        ).fetchone()
+    qml = _style(nmea_report.out_dir / "report.gpkg", "lone_reports")
     assert '<temporal enabled="1" mode="2" startField="start_utc" endField="end_utc"' in qml
     assert 'limitMode="1"' in qml
 
