@@ -58,7 +58,9 @@ TOP_LEVEL_KEYS = frozenset(
         "replay",
     }
 )
-STAGE_TABLES = ("ingest", "manoeuvrability", "colregs", "replay")
+# The tables of the replay's stages, and the stage tables with ingest's.
+REPLAY_STAGE_TABLES = ("manoeuvrability", "colregs", "replay")
+STAGE_TABLES = ("ingest", *REPLAY_STAGE_TABLES)
 REGION_KEYS = frozenset({"lat_min", "lat_max", "lon_min", "lon_max", "polygon", "polygon_file"})
 TIME_KEYS = frozenset({"start", "end"})
 VESSEL_KEYS = frozenset(
@@ -294,7 +296,7 @@ class Query:
         """Whether the query holds a table of the replay's stages, which a command that does
         not use it still checks (``jobs.replay_params.stage_tables``), so that a query one
         command accepts, the others accept."""
-        return any(name in self.tables for name in ("replay", "colregs", "manoeuvrability"))
+        return any(name in self.tables for name in REPLAY_STAGE_TABLES)
 
     def frame(self) -> LocalFrame | None:
         """The run's local metric frame, centred on the region's box; None without a region."""

@@ -308,7 +308,7 @@ class Channels:
         reach = np.full(len(centre_xy), float(self._reach_m.max(initial=1.0)))
         lines = section_lines(centre_xy, right_unit, (reach, reach))
         line_of_pair, area_rank = self._tree.query(lines, predicate="intersects")
-        areas = np.asarray([self.items[i].geometry for i in self._areas], dtype=object)
+        areas = self._tree.geometries  # the areas, in their rank's order
         pieces, pair = shapely.get_parts(
             shapely.intersection(lines[line_of_pair], areas[area_rank]), return_index=True
         )

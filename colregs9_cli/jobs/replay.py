@@ -309,7 +309,7 @@ def run_replay(
             accept_chart_gaps,
         )
         manifest["parameters"].update(domains=domains.value, vessel_tracks=vessel_tracks)
-        manifest["slabs"] = _slab_facts(params.replay.slab_s, len(slabs), scheduler or workers)
+        manifest["slabs"] = _slab_facts(params.replay.slab_s, len(slabs), workers, scheduler)
         manifest["slabs"]["pairs_followed_past_their_slab"] = sum(r.followed for r in results)
         result = ReplayResult(
             query_name=query.name,
@@ -329,11 +329,11 @@ def run_replay(
         return dataclasses.replace(result, files=files, text=format_summary(result))
 
 
-def _slab_facts(slab_s: float, slabs: int, where: str | int) -> dict[str, Any]:
-    """run.json's ``slabs``: their length and number, and the workers (a count, or the
-    scheduler's address)."""
-    workers = f"scheduler {where}" if isinstance(where, str) else where
-    return {"slab_s": slab_s, "slabs": slabs, "workers": workers}
+def _slab_facts(slab_s: float, slabs: int, workers: int, scheduler: str | None) -> dict[str, Any]:
+    """run.json's ``slabs``: their length and number, and the workers (the local count, or
+    the scheduler's address)."""
+    where = workers if scheduler is None else f"scheduler {scheduler}"
+    return {"slab_s": slab_s, "slabs": slabs, "workers": where}
 
 
 def _checked_options(workers: int, scratch_dir: Path | None, domains: Domains | str) -> Domains:
