@@ -18,6 +18,7 @@ from colregs9_cli.core.audit import (
     all_of,
     conduct,
     negated,
+    observed_rows,
     stand_on_turned_to_port_for_vessel_on_port,
 )
 from colregs9_cli.core.colregs import Role, Situation
@@ -345,3 +346,74 @@ def test_rule_17c_a_port_turn_breaches_it_on_exactly_one_of_mirrored_bearings(
 
     assert {breached(bearing_deg), breached(-bearing_deg)} == {Fact.TRUE, Fact.FALSE}
     assert breached(bearing_deg + 360.0) is breached(bearing_deg)
+
+
+# Only what her reports show: rows 0-3 lie inside one 151 s gap between two reports (the
+# trigger 4 s into it), row 4 is the report that closes it.
+IN_ONE_GAP = np.array([False, False, False, False, True, True])
+
+
+def test_a_change_drawn_inside_one_gap_around_the_trigger_is_no_action() -> None:
+    # San Diego, SEAS THE DAY: 0.4 kn at 00:00:21, 4.8 kn at 00:02:52; interpolated, she
+    # "sped up" 45 s after the trigger. When in the gap she did is unknown.
+    speed = np.array([0.5, 1.8, 3.1, 4.4, 4.8, 4.8])
+    course = np.full(6, 221.0)
+    assert conduct(course, speed, PARAMS).action is Action.SPED_UP
+    result = conduct(course, speed, PARAMS, IN_ONE_GAP)
+    assert (result.changed, result.action, result.action_row) == (
+        Fact.INSUFFICIENT,
+        Action.INSUFFICIENT,
+        None,
+    )
+
+
+def test_with_no_change_across_the_trigger_gap_her_reference_is_her_first_report() -> None:
+    # the course interpolated toward a turn seen only at a report after the closest approach
+    # must not count; a turn between two reports after the trigger does, at the later one
+    course = np.array([45.0, 45.0, 44.0, 44.0, 44.0, 20.0])
+    speed = np.full(6, 3.5)
+    result = conduct(course, speed, PARAMS, IN_ONE_GAP)
+    assert (result.changed, result.action, result.action_row) == (
+        Fact.TRUE,
+        Action.PORT_TURN,
+        5,
+    )
+    interpolated_turn = np.array([45.0, 44.0, 44.0, 44.0, 44.0, 35.0])
+    assert conduct(interpolated_turn, speed, PARAMS, IN_ONE_GAP).action is Action.NONE
+
+
+def test_no_observed_row_is_insufficient() -> None:
+    result = conduct(np.full(3, 90.0), np.full(3, 8.0), PARAMS, np.zeros(3, bool))
+    assert result.action is Action.INSUFFICIENT
+
+
+def test_observed_rows_are_reports_and_short_gaps() -> None:
+    gap_s = np.array([151.0, 151.0, 0.0, 10.0, 31.0, np.nan])
+    nearest_s = np.array([4.0, 40.0, 0.0, 5.0, 0.5, np.nan])
+    assert observed_rows(gap_s, nearest_s, 1.0, PARAMS).tolist() == [
+        False,
+        False,
+        True,
+        True,
+        True,
+        False,
+    ]
+
+
+def test_observed_gap_must_be_a_number() -> None:
+    with pytest.raises(ParameterError, match="observed_gap_max_s"):
+        dataclasses.replace(PARAMS, observed_gap_max_s=math.nan)
+
+
+def test_sandiego_actions_inside_one_report_gap_are_not_judged(sandiego_replay) -> None:
+    seas_the_day = 368185860  # reports 0.4 kn at 00:00:21, then 4.8 kn at 00:02:52
+    pairs = {
+        p.summary.name_a: p.summary
+        for p in sandiego_replay.pairs
+        if seas_the_day in (p.summary.mmsi_a, p.summary.mmsi_b)
+    }
+    for name in ("FREEDOM", "CASSIOPEIA"):
+        summary = pairs[name]
+        assert summary.give_way_vessels == str(seas_the_day)
+        assert summary.give_way_vessel_acted == "insufficient-data"
+        assert summary.give_way_action == "insufficient-data"

@@ -17,6 +17,17 @@ before the closest approach the answer is ``insufficient-data``, never ``false``
   the row where the slowing began. With no change, and her course judged at fewer than half
   of the steps, the answer is ``insufficient-data``: a slow vessel's turn cannot be seen in
   her COG.
+- **Only what her reports show.** Her course and speed are judged only at *observed* rows:
+  at one of her reports, or interpolated across a gap between two reports of at most
+  ``observed_gap_max_s`` (30 s, the interval of a Class B transponder above 2 kn and the
+  longest of a Class A one under way, ITU-R M.1371-5 Table 1 and Annex 2 Table 2). Inside a
+  longer gap the series is a straight line drawn between two reports, and a change that
+  line shows happened at some unknown time in the gap (San Diego: a yacht reporting 0.4 kn
+  and, 151 s later, 4.8 kn "sped up" 45 s after a trigger 4 s into that gap). Her reference
+  is her first observed row. When the trigger falls inside a longer gap and her course or
+  speed changed across it (the trigger's interpolated values against the gap's closing
+  report), the change may have come before the trigger or after it: her conduct is
+  ``insufficient-data``.
 - **The kind of action** (``action_as_rule_asks``). Whether the give-way vessel's action is
   the kind the deciding rule asks for (judged on her first action only):
 
@@ -102,12 +113,13 @@ class ConductParams:
     speed_change_min_kn: float
     course_judged_above_kn: float
     stopped_below_kn: float = 0.5
+    observed_gap_max_s: float = 30.0
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.stopped_below_kn) and self.stopped_below_kn >= 0.0):
-            raise ParameterError(
-                f"[replay] stopped_below_kn = {self.stopped_below_kn!r}: give a number >= 0"
-            )
+        for name in ("stopped_below_kn", "observed_gap_max_s"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0.0):
+                raise ParameterError(f"[replay] {name} = {value!r}: give a number >= 0")
 
 
 @dataclass(frozen=True)
@@ -122,10 +134,49 @@ class Conduct:
 INSUFFICIENT_CONDUCT = Conduct(Fact.INSUFFICIENT, Action.INSUFFICIENT, None)
 
 
-def conduct(course_deg: ArrayLike, sog_kn: ArrayLike, params: ConductParams) -> Conduct:
-    """One vessel's conduct over the rows given (the trigger to the closest approach)."""
-    course = np.asarray(course_deg, dtype=float)
-    sog = np.asarray(sog_kn, dtype=float)
+def observed_rows(
+    report_gap_s: ArrayLike, nearest_report_s: ArrayLike, step_s: float, params: ConductParams
+) -> np.ndarray:
+    """The rows where a vessel's course and speed are observed (module docstring): at one of
+    her reports (one less than a step away) or interpolated across a short gap."""
+    gap = np.asarray(report_gap_s, dtype=float)
+    nearest = np.asarray(nearest_report_s, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return (nearest < step_s) | (gap <= params.observed_gap_max_s)
+
+
+def conduct(
+    course_deg: ArrayLike,
+    sog_kn: ArrayLike,
+    params: ConductParams,
+    observed: ArrayLike | None = None,
+) -> Conduct:
+    """One vessel's conduct over the rows given (the trigger to the closest approach).
+
+    ``observed`` (``observed_rows``; default: every row) marks the rows her reports show."""
+    course_all = np.asarray(course_deg, dtype=float)
+    sog_all = np.asarray(sog_kn, dtype=float)
+    seen = np.ones(len(sog_all), bool) if observed is None else np.asarray(observed, bool)
+    rows = np.flatnonzero(seen)
+    if len(rows) == 0:
+        return INSUFFICIENT_CONDUCT
+    if rows[0] > 0 and _changed_between(course_all, sog_all, 0, int(rows[0]), params):
+        return INSUFFICIENT_CONDUCT
+    found = _conduct_at(course_all[rows], sog_all[rows], params)
+    if found.action_row is None:
+        return found
+    return Conduct(found.changed, found.action, int(rows[found.action_row]))
+
+
+def _changed_between(
+    course: np.ndarray, sog: np.ndarray, first: int, last: int, params: ConductParams
+) -> bool:
+    """Whether her course or speed differs between two rows by an action's threshold."""
+    return _conduct_at(course[[first, last]], sog[[first, last]], params).changed is Fact.TRUE
+
+
+def _conduct_at(course: np.ndarray, sog: np.ndarray, params: ConductParams) -> Conduct:
+    """``conduct`` over rows that are all observed (row 0 the reference)."""
     judged = np.isfinite(course) & (sog >= params.course_judged_above_kn)
     events: list[tuple[int, Action]] = []
     if judged.any():

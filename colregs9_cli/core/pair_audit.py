@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from .audit import INSUFFICIENT_CONDUCT, Conduct, ConductParams, conduct
+from .audit import INSUFFICIENT_CONDUCT, Conduct, ConductParams, conduct, observed_rows
 from .hull import HullOffsets, least_hull_distance_geodetic_m, offsets_from_ais
 from .passing import Passing, minimum_evidence
 from .tracks import ANTENNA_OFFSET_COLUMNS
@@ -189,6 +189,9 @@ def _audit_conduct(
             _against_bend(until[f"{prefix}course_deg"].to_numpy(dtype=float), bends_deg, vessel),
             until[f"{prefix}sog_kn"].to_numpy(dtype=float),
             params,
+            observed_rows(
+                until[f"{prefix}report_gap_s"], until[f"{prefix}nearest_report_s"], step_s, params
+            ),
         )
         for vessel, prefix in enumerate(PREFIXES)
     )

@@ -72,6 +72,9 @@ class ReplayParams:
       0.6 to 0.98 kn is no action), before CPA.
     - ``course_judged_above_kn``: a course change counts only at speeds of at least this much,
       where COG means something (at 0.5 kn it is mostly GPS noise).
+    - ``observed_gap_max_s``: course and speed are judged only at a vessel's reports and where
+      interpolated across gaps of at most this much (``audit.py``): inside a longer gap a
+      change has no time.
     - ``restricted_nav_statuses``: AIS navigational status codes that mean "restricted
       manoeuvrability" for event d2 of the rule 9 automaton (3 restricted manoeuvrability,
       4 constrained by her draught).
@@ -97,6 +100,7 @@ class ReplayParams:
     speed_change_min_kn: float = 1.0
     course_judged_above_kn: float = 2.0
     stopped_below_kn: float = ConductParams.stopped_below_kn
+    observed_gap_max_s: float = ConductParams.observed_gap_max_s
     restricted_nav_statuses: frozenset[int] = Rule9Params.restricted_nav_statuses
     reassess_every_s: float = Rule9Params.reassess_every_s
     default_length_m: float | None = DimensionDefaults.length_m
