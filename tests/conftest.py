@@ -6,7 +6,7 @@ import matplotlib
 import pytest
 from hypothesis import settings
 
-from fixture_files import FIXTURES, SANDIEGO_AIS, SANDIEGO_ENC
+from fixture_files import FIXTURES, NMEA, SANDIEGO_AIS, SANDIEGO_ENC
 
 matplotlib.use("Agg")
 # No time limit per example: Hypothesis' deadline is a timed assertion, and on a loaded
@@ -28,3 +28,13 @@ def sandiego_replay(tmp_path_factory: pytest.TempPathFactory):
 
     out = tmp_path_factory.mktemp("sandiego")
     return run_replay([SANDIEGO_AIS], chart_paths=[SANDIEGO_ENC], out_dir=out, plots=False)
+
+
+@pytest.fixture(scope="session")
+def dma_nmea_replay(tmp_path_factory: pytest.TempPathFactory):
+    """The replay of the DMA NMEA log (five minutes, no chart) without figures, shared by the
+    modules that read it (read only)."""
+    from colregs9_cli.jobs.replay import run_replay
+
+    out = tmp_path_factory.mktemp("dma_nmea")
+    return run_replay([NMEA], out_dir=out, plots=False)

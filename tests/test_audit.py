@@ -19,6 +19,7 @@ from colregs9_cli.core.audit import (
     conduct,
     negated,
     observed_rows,
+    passed_port_to_port,
     stand_on_turned_to_port_for_vessel_on_port,
 )
 from colregs9_cli.core.colregs import Role, Situation
@@ -417,3 +418,88 @@ def test_sandiego_actions_inside_one_report_gap_are_not_judged(sandiego_replay) 
         assert summary.give_way_vessels == str(seas_the_day)
         assert summary.give_way_vessel_acted == "insufficient-data"
         assert summary.give_way_action == "insufficient-data"
+
+
+def test_sandiego_a_course_drawn_through_a_turn_leaves_the_situation_in_doubt(
+    sandiego_replay,
+) -> None:
+    # SHELTER ISLAND reported 087.5 deg at 00:07:12 and 126.2 deg at 00:10:13; the crossing
+    # with WHITE NIGHTS was read from the 113 deg drawn between them at the trigger.
+    shelter_island, white_nights = 338187796, 338372419
+    (summary,) = (
+        p.summary
+        for p in sandiego_replay.pairs
+        if {p.summary.mmsi_a, p.summary.mmsi_b} == {shelter_island, white_nights}
+    )
+    assert summary.situation_ambiguous is True
+
+
+@pytest.mark.parametrize("rule", [DecidingRule.RULE_13, DecidingRule.RULE_9, DecidingRule.RULE_18])
+@pytest.mark.parametrize("turn", [Action.STARBOARD_TURN, Action.PORT_TURN])
+def test_a_turn_that_closed_the_cpa_kept_out_of_nobodys_way(
+    rule: DecidingRule, turn: Action
+) -> None:
+    situation = Situation.OVERTAKING if rule is DecidingRule.RULE_13 else Situation.CROSSING
+    asks = action_as_rule_asks(situation, rule, Role.GIVE_WAY, turn, closed_cpa=False)
+    closed = action_as_rule_asks(situation, rule, Role.GIVE_WAY, turn, closed_cpa=True)
+    assert (asks, closed) == (Fact.TRUE, Fact.FALSE)
+    # a slowing opens the time, whatever the predicted distance did meanwhile
+    slowed = action_as_rule_asks(situation, rule, Role.GIVE_WAY, Action.SLOWED, closed_cpa=True)
+    assert slowed is Fact.TRUE
+
+
+def test_rules_that_name_the_side_judge_the_kind_alone() -> None:
+    # rule 14(a) asks a starboard turn, whatever the other vessel did to the predicted CPA
+    head_on = (Situation.HEAD_ON, DecidingRule.RULE_14, Role.GIVE_WAY, Action.STARBOARD_TURN)
+    assert action_as_rule_asks(*head_on, closed_cpa=True) is Fact.TRUE
+
+
+def test_dma_the_boat_that_turned_toward_the_ship_she_overtook_did_not_keep_clear(
+    dma_nmea_replay,
+) -> None:
+    # 211546840 overtaking 636092478: a port turn at 12:02:43 that took the predicted CPA
+    # from 150 m to 26 m
+    (summary,) = (
+        p.summary
+        for p in dma_nmea_replay.pairs
+        if {p.summary.mmsi_a, p.summary.mmsi_b} == {211546840, 636092478}
+    )
+    assert (summary.situation, summary.give_way_vessels) == ("overtaking", "211546840")
+    assert summary.give_way_action == "port-turn"
+    assert summary.give_way_action_as_rule_asks == "false"
+
+
+@pytest.mark.parametrize(
+    ("bearings_deg", "judged", "expected"),
+    [
+        ((270.0, 290.0), True, Fact.TRUE),  # each has the other on her port side
+        ((90.0, 70.0), True, Fact.FALSE),  # starboard to starboard
+        ((270.0, 70.0), True, Fact.FALSE),  # one each side: the geometry of a crossing
+        ((270.0, 180.0), True, Fact.FALSE),  # dead astern is on neither side
+        ((270.0, 290.0), False, Fact.INSUFFICIENT),  # a course not judged (COG noise)
+        ((270.0, math.nan), True, Fact.INSUFFICIENT),
+    ],
+)
+def test_passed_port_to_port(
+    bearings_deg: tuple[float, float], judged: bool, expected: Fact
+) -> None:
+    assert passed_port_to_port(Situation.HEAD_ON, bearings_deg, judged) is expected
+
+
+def test_passed_port_to_port_is_judged_for_head_on_alone() -> None:
+    for situation in (Situation.CROSSING, Situation.OVERTAKING, Situation.NONE):
+        assert passed_port_to_port(situation, (270.0, 290.0), True) is None
+
+
+def test_sandiego_a_channel_passing_port_to_port(sandiego_replay) -> None:
+    # CHAMPAGNE and LETO meet in the San Diego Harbor Channel, each to her own starboard
+    # side of its axis (+44 m and +21 m), and pass port to port at 93 m: no turn was needed.
+    champagne, leto = 367412850, 368103590
+    (summary,) = (
+        p.summary
+        for p in sandiego_replay.pairs
+        if {p.summary.mmsi_a, p.summary.mmsi_b} == {champagne, leto}
+    )
+    assert summary.situation == "head-on"
+    assert summary.passed_port_to_port == "true"
+    assert summary.give_way_vessel_acted == "false"

@@ -231,6 +231,19 @@ def test_samples_carry_the_report_gap_they_were_interpolated_across() -> None:
     assert nearest[2.0] == nearest[5.0] == nearest[23.0] == 0.0
 
 
+def test_samples_carry_the_turn_of_the_gap_they_were_interpolated_across() -> None:
+    # COG 350 deg at T0+2 s, 020 deg at 5 s (30 deg over north), 020 deg again at 23 s
+    samples = build_tracks(
+        reports([2, 5, 23], [0.0, 30.0, 210.0], [0.0] * 3, cog_deg=[350.0, 20.0, 20.0]),
+        FRAME,
+        TrackParams(),
+    ).samples
+    turn = dict(zip(samples["t_s"] - T0_S, samples["gap_turn_deg"], strict=True))
+    assert [turn[t] for t in (2.0, 3.0, 4.0, 5.0, 6.0, 22.0, 23.0)] == pytest.approx(
+        [0.0, 30.0, 30.0, 0.0, 0.0, 0.0, 0.0]
+    )
+
+
 def test_a_sample_between_sub_second_reports_is_not_at_a_report() -> None:
     samples = build_tracks(
         reports([0.4, 3.6], [0.0, 32.0], [0.0, 0.0]), FRAME, TrackParams()

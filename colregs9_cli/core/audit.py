@@ -38,12 +38,16 @@ before the closest approach the answer is ``insufficient-data``, never ``false``
                                                     none
   15 crossing   starboard turn, slowed, stopped     port turn, sped up ("avoid crossing
                 (rules 15, 16, 8(e))                ahead", rule 15), none (rule 16)
-  13, 9, 18     a turn either way, slowed, stopped  sped up, none
+  13, 9, 18     a turn either way that opened the   sped up, none, a turn after which
+                predicted CPA, slowed, stopped      the predicted CPA was nearer
   ============  ==================================  =====================================
 
   Rules 13 ("keep out of the way"), 9(b)–(d) ("not impede") and 18 ("keep out of the way")
   name no side: which side is clear depends on where the other vessel is and on the water,
-  so either turn is of the kind they ask; whether the pass was in fact clear is the separate
+  so either turn is of the kind they ask, if it turned her away: a turn after which the
+  predicted closest approach is nearer than at the trigger closed on the other vessel and
+  kept out of nobody's way (DMA: a boat overtaking a ship turned to port toward her, and the
+  predicted CPA fell from 150 m to 26 m). Whether the pass was in fact clear is the separate
   ``passing.Passing.min_separation_m``. Rule 14(a) names the alteration to starboard: a slowing may
   go with it, but one that comes first is the action judged, and is not the alteration.
   Speeding up is never of the kind: rule 8(e) names slackening speed,
@@ -53,6 +57,8 @@ before the closest approach the answer is ``insufficient-data``, never ``false``
   action", and the trigger (CPA under ``cpa_req_m`` within ``tcpa_act_s``) says one was
   needed. An action that is ``insufficient-data`` gives ``insufficient-data``; a vessel that
   is not a give-way vessel, or a pair with no situation, gives ``None`` (not applicable).
+- **Rule 14(a)** (``passed_port_to_port``): in a head-on situation, whether each vessel had
+  the other on her port side at the least separation.
 - **Rule 17(c)** (``stand_on_turned_to_port_for_vessel_on_port``). In a rule 15 crossing the
   stand-on vessel that acts "shall, if the circumstances of the case admit, not alter course
   to port for a vessel on her own port side". The fact is ``true`` when her action was a
@@ -216,6 +222,8 @@ _KINDS_ASKED: dict[DecidingRule, frozenset[Action]] = {
     DecidingRule.RULE_9: _KEEPS_OUT_OF_THE_WAY,
     DecidingRule.RULE_18: _KEEPS_OUT_OF_THE_WAY,
 }
+_TURNS = frozenset({Action.STARBOARD_TURN, Action.PORT_TURN})
+_NAME_NO_SIDE = frozenset({DecidingRule.RULE_13, DecidingRule.RULE_9, DecidingRule.RULE_18})
 # rule9.decide_pair: rules 13-15 decide only their own situation, and rule 13 keeps the
 # roles of every overtaking, so rules 9 and 18 never decide one.
 _SITUATIONS_DECIDED: dict[DecidingRule, frozenset[Situation]] = {
@@ -237,13 +245,19 @@ def _decided(situation: Situation, deciding_rule: DecidingRule) -> tuple[Situati
 
 
 def action_as_rule_asks(
-    situation: Situation, deciding_rule: DecidingRule, role: Role, action: Action
+    situation: Situation,
+    deciding_rule: DecidingRule,
+    role: Role,
+    action: Action,
+    closed_cpa: bool = False,
 ) -> Fact | None:
     """Whether a vessel's action is of the kind the deciding rule asks of a give-way vessel.
 
-    ``role`` is her final role (``PairVerdict.role_final``). ``None`` where there is no
-    give-way action to judge: she is not a give-way vessel, or the pair has no situation.
-    Members or their strings (as in pairs.csv) are accepted.
+    ``role`` is her final role (``PairVerdict.role_final``). ``closed_cpa``: the predicted
+    closest approach at her action's row is nearer than at the trigger (a turn then counts
+    for no rule that names no side). ``None`` where there is no give-way action to judge: she
+    is not a give-way vessel, or the pair has no situation. Members or their strings (as in
+    pairs.csv) are accepted.
     """
     situation, deciding_rule = _decided(situation, deciding_rule)
     if deciding_rule is DecidingRule.NONE or Role(role) is not Role.GIVE_WAY:
@@ -251,6 +265,8 @@ def action_as_rule_asks(
     action = Action(action)
     if action is Action.INSUFFICIENT:
         return Fact.INSUFFICIENT
+    if closed_cpa and action in _TURNS and deciding_rule in _NAME_NO_SIDE:
+        return Fact.FALSE
     return Fact.of(action in _KINDS_ASKED[deciding_rule])
 
 
@@ -280,6 +296,26 @@ def stand_on_turned_to_port_for_vessel_on_port(
         return Fact.INSUFFICIENT
     # dead ahead (0°) and dead astern (180°) are on neither side
     return Fact.of(float(wrap_deg(give_way_bearing_deg)) > 180.0)
+
+
+def passed_port_to_port(
+    situation: Situation, bearings_deg: tuple[float, float], courses_judged: bool
+) -> Fact | None:
+    """Rule 14(a): two vessels meeting head-on pass "on the port side of the other".
+
+    ``bearings_deg``: each vessel's bearing of the other at the least separation, clockwise
+    from her course (``beta_deg``, ``beta_prime_deg``); true when each had the other on her
+    port side (in (180°, 360°)). ``courses_judged``: both courses there are judged (at
+    ``course_judged_above_kn`` or more), else ``insufficient-data``. ``None`` unless the
+    situation is head-on. A head-on pair that already passes port to port needs no turn:
+    this is the fact to read beside a ``give_way_vessel_acted`` of false (two vessels each
+    keeping to her own side of a channel).
+    """
+    if Situation(situation) is not Situation.HEAD_ON:
+        return None
+    if not courses_judged or not all(math.isfinite(b) for b in bearings_deg):
+        return Fact.INSUFFICIENT
+    return Fact.of(all(float(wrap_deg(b)) > 180.0 for b in bearings_deg))
 
 
 def all_of(facts: Iterable[Fact]) -> Fact:

@@ -258,6 +258,21 @@ def _held(g_a: ColregsEvaluation, meeting_in_channel: bool = False) -> ColregsEv
     )
 
 
+def _course_drawn_across_a_turn(series: pd.DataFrame, conduct: ConductParams) -> np.ndarray:
+    """Steps where either vessel's course is interpolated across a report gap longer than
+    ``observed_gap_max_s`` in which she turned by at least ``course_change_deg``: the course
+    that placed her in a sector is a straight line drawn through her turn (San Diego:
+    SHELTER ISLAND reported 087° and, three minutes later, 126°; the crossing read from the
+    113° between was a meeting at the later report)."""
+    drawn = np.zeros(len(series), dtype=bool)
+    for prefix in PREFIXES:
+        with np.errstate(invalid="ignore"):
+            drawn |= (
+                series[f"{prefix}report_gap_s"].to_numpy(dtype=float) > conduct.observed_gap_max_s
+            ) & (series[f"{prefix}gap_turn_deg"].to_numpy(dtype=float) >= conduct.course_change_deg)
+    return drawn
+
+
 def _pair_steps(
     series: pd.DataFrame,
     dimensions: tuple[VesselDimensions, VesselDimensions],
@@ -273,6 +288,11 @@ def _pair_steps(
         *Kinematics.pair_from_series(series),
         params.colregs,
         course_judged_above_kn=params.conduct.course_judged_above_kn,
+    )
+    g_a = dataclasses.replace(
+        g_a,
+        ambiguous=g_a.ambiguous
+        | (_course_drawn_across_a_turn(series, params.conduct) & (g_a.situation != Situation.NONE)),
     )
     held = _held(g_a, meeting_in_channel)
     situation = held.situation[0]
@@ -409,6 +429,7 @@ def evaluate_pair(
         restricted_nav_statuses=params.rule9.restricted_nav_statuses,
         interaction=interaction,
         swing_model=params.manoeuvrability.swing_model,
+        course_judged_above_kn=params.conduct.course_judged_above_kn,
         in_channel=(in_channel[0], in_channel[1]),
         standings=standings,
     )

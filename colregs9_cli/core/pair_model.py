@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
+import numpy as np
 import pandas as pd
 
 from .ais_claims import NavStatusBelief
@@ -25,10 +26,11 @@ from .audit import (
     Fact,
     action_as_rule_asks,
     all_of,
+    passed_port_to_port,
     stand_on_turned_to_port_for_vessel_on_port,
 )
 from .channel_audit import NOT_CHARTED, VesselInChannel
-from .colregs import ColregsEvaluation, Role
+from .colregs import ColregsEvaluation, Role, Situation
 from .encounters import Encounter
 from .interactions import Interaction, InteractionKind
 from .manoeuvrability import ManoeuvrabilityAssessment, Restriction, SwingModel
@@ -102,6 +104,7 @@ class PairEvaluation:
     restricted_nav_statuses: frozenset[int]
     interaction: Interaction
     swing_model: SwingModel
+    course_judged_above_kn: float  # ``ConductParams``': below it a COG is noise
     # Each vessel and the charted channels (channel_audit.py), vessel order, and what rule 9's
     # clauses read of them (None: the chart charts no channel).
     in_channel: tuple[VesselInChannel, VesselInChannel] = (NOT_CHARTED, NOT_CHARTED)
@@ -150,9 +153,15 @@ class PairEvaluation:
         """Whether every give-way vessel's action is of the kind the deciding rule asks for
         (``audit.action_as_rule_asks``); None without a give-way vessel."""
         verdict = self.verdict
+        cpa_m = self.steps.series["cpa_m"].to_numpy(dtype=float)
         facts = [
             action_as_rule_asks(
-                verdict.situation, verdict.deciding_rule, role, vessel.conduct.action
+                verdict.situation,
+                verdict.deciding_rule,
+                role,
+                vessel.conduct.action,
+                closed_cpa=vessel.conduct.action_row is not None
+                and bool(cpa_m[vessel.conduct.action_row] < cpa_m[0]),
             )
             for vessel, role in zip(self.vessels, verdict.role_final, strict=True)
         ]
@@ -180,6 +189,24 @@ class PairEvaluation:
         ]
         judged = [fact for fact in facts if fact is not None]
         return all_of(judged) if judged else None
+
+    @property
+    def passed_port_to_port(self) -> Fact | None:
+        """Rule 14(a) at the least separation (``audit.passed_port_to_port``); None unless
+        head-on, ``insufficient-data`` where the data stop before the closest approach."""
+        situation = self.verdict.situation
+        if situation is not Situation.HEAD_ON:
+            return None
+        times = self.steps.series["timestamp"]
+        if not self.audit.covers_cpa or self.audit.cpa_utc is None:
+            return Fact.INSUFFICIENT
+        row = int(np.flatnonzero((times == self.audit.cpa_utc).to_numpy())[0])
+        speeds_kn = [float(self.steps.series[f"{prefix}sog_kn"].iloc[row]) for prefix in PREFIXES]
+        return passed_port_to_port(
+            situation,
+            (float(self.steps.g_a.beta_deg[row]), float(self.steps.g_a.beta_prime_deg[row])),
+            all(speed >= self.course_judged_above_kn for speed in speeds_kn),
+        )
 
     @property
     def turn_radius_m(self) -> tuple[float | None, float | None]:

@@ -121,6 +121,7 @@ class PairSummary:
     action_before_cpa_s: str | None
     stand_on_vessel_kept_course: Fact | None
     stand_on_turned_to_port_for_vessel_on_port: Fact | None
+    passed_port_to_port: Fact | None
     action_a: Action | None
     action_b: Action | None
     length_m_a: float
@@ -162,6 +163,7 @@ PAIR_VERDICT_COLUMNS: tuple[str, ...] = (
     "action_before_cpa_s",
     "stand_on_vessel_kept_course",
     "stand_on_turned_to_port_for_vessel_on_port",
+    "passed_port_to_port",
     "action_a",
     "action_b",
     "keeps_to_starboard_side_a",
@@ -282,6 +284,7 @@ class EncounterSummary:
     action_before_cpa_s: str | None
     stand_on_vessel_kept_course: Fact | None
     stand_on_turned_to_port_for_vessel_on_port: Fact | None
+    passed_port_to_port: Fact | None
     own_course_deg_at_trigger: float
     own_speed_kn_at_trigger: float
     target_course_deg_at_trigger: float
@@ -322,6 +325,7 @@ ENCOUNTER_VERDICT_COLUMNS: tuple[str, ...] = (
     "action_before_cpa_s",
     "stand_on_vessel_kept_course",
     "stand_on_turned_to_port_for_vessel_on_port",
+    "passed_port_to_port",
     "own_keeps_to_starboard_side",
     "target_keeps_to_starboard_side",
     "own_keeps_to_starboard_side_basis",
@@ -543,6 +547,7 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
             all_of(negated(v.conduct.changed) for v in stand_on) if stand_on else None
         ),
         stand_on_turned_to_port_for_vessel_on_port=pair.stand_on_turned_to_port,
+        passed_port_to_port=pair.passed_port_to_port,
         action_a=a.conduct.action,
         action_b=b.conduct.action,
         length_m_a=a.dimensions.length_m,
@@ -641,6 +646,7 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         action_before_cpa_s=pair.action_before_cpa_s,
         stand_on_vessel_kept_course=pair.stand_on_vessel_kept_course,
         stand_on_turned_to_port_for_vessel_on_port=pair.stand_on_turned_to_port_for_vessel_on_port,
+        passed_port_to_port=pair.passed_port_to_port,
         own_course_deg_at_trigger=own.course_deg,
         own_speed_kn_at_trigger=own.speed_kn,
         target_course_deg_at_trigger=target.course_deg,

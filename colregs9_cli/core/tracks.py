@@ -35,8 +35,10 @@ The rules, in order, per MMSI with reports sorted by time:
    interpolated along the shorter arc (359° → 1° passes 0°, never 180°); the navigational
    status is the latest report's (held, not interpolated). Each sample carries
    ``report_gap_s``, the time between the two reports that bracket it (0 at a report's own
-   time), and ``nearest_report_s``, the time to the nearer of them: a position interpolated
-   across a long gap is an estimate, not an observation (a river bend crossed by a 195 s gap).
+   time), ``nearest_report_s``, the time to the nearer of them, and ``gap_turn_deg``, how far
+   her course turned between them (0 at a report): a position interpolated across a long gap
+   is an estimate, not an observation (a river bend crossed by a 195 s gap), and so is a
+   course interpolated across a turn.
 
 The course used for bearings (``course_deg``) is COG or heading (``CourseSource``); velocity
 always comes from COG and SOG, the motion over ground.
@@ -131,6 +133,7 @@ STATE_COLUMNS: tuple[str, ...] = (
     "nav_status",
     "report_gap_s",
     "nearest_report_s",
+    "gap_turn_deg",
 )
 SAMPLE_COLUMNS: tuple[str, ...] = ("mmsi", "segment_id", "step", "t_s", "timestamp", *STATE_COLUMNS)
 
@@ -689,6 +692,10 @@ def _resample(
     data["report_gap_s"] = np.where(weight > 0.0, dt, 0.0)
     data["nearest_report_s"] = np.where(
         weight > 0.0, np.minimum(grid_t - t[left], t[right] - grid_t), 0.0
+    )
+    course = circular["course_deg"]
+    data["gap_turn_deg"] = np.where(
+        weight > 0.0, np.abs(signed_angle_deg(course[right] - course[left])), 0.0
     )
     status_index = np.where(weight == 1.0, right, left)
     data["nav_status"] = pd.array(nav_status[status_index], dtype="Int64")

@@ -479,6 +479,7 @@ def verdict_counts(pairs: Sequence[PairOutcome]) -> dict[str, Any]:
         "data_covers_cpa": sum(s.data_covers_cpa for s in summaries),
         "give_way_vessel_acted": count([s.give_way_vessel_acted for s in encounters]),
         "give_way_action_as_rule_asks": count([s.give_way_action_as_rule_asks for s in encounters]),
+        "passed_port_to_port": count([s.passed_port_to_port for s in encounters]),
         "estimated_restricted": count(
             [e for s in encounters for e in (s.estimated_restricted_a, s.estimated_restricted_b)]
         ),
