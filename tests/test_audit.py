@@ -17,6 +17,7 @@ from colregs9_cli.core.audit import (
     action_as_rule_asks,
     all_of,
     conduct,
+    course_drawn_through_a_turn,
     negated,
     observed_rows,
     passed_port_to_port,
@@ -415,9 +416,10 @@ def test_sandiego_actions_inside_one_report_gap_are_not_judged(sandiego_replay) 
     }
     for name in ("FREEDOM", "CASSIOPEIA"):
         summary = pairs[name]
-        assert summary.give_way_vessels == str(seas_the_day)
-        assert summary.give_way_vessel_acted == "insufficient-data"
-        assert summary.give_way_action == "insufficient-data"
+        assert str(seas_the_day) in summary.give_way_vessels.split(";")
+        assert summary.mmsi_b == seas_the_day
+        assert summary.action_b == "insufficient-data"
+        assert "sped-up" not in summary.give_way_action
 
 
 def test_sandiego_a_course_drawn_through_a_turn_leaves_the_situation_in_doubt(
@@ -503,3 +505,15 @@ def test_sandiego_a_channel_passing_port_to_port(sandiego_replay) -> None:
     assert summary.situation == "head-on"
     assert summary.passed_port_to_port == "true"
     assert summary.give_way_vessel_acted == "false"
+
+
+def test_a_course_is_drawn_through_a_turn_only_across_a_long_gap_with_a_turn() -> None:
+    gap_s = np.array([0.0, 20.0, 120.0, 120.0, 120.0])
+    turn_deg = np.array([0.0, 40.0, 40.0, 14.9, np.nan])
+    assert course_drawn_through_a_turn(gap_s, turn_deg, PARAMS).tolist() == [
+        False,
+        False,  # a short gap: the turn is seen closely enough
+        True,
+        False,  # less than an action's turn
+        False,
+    ]

@@ -48,7 +48,14 @@ BOUNDARY_CASES = [
     (20.0, 10.0, HEAD_ON, GW, GW, False),
     (350.0, 340.0, HEAD_ON, GW, GW, False),
     (22.5 + EPS, 10.0, CROSSING, GW, SO, False),
-    (350.0, 337.5 - EPS, CROSSING, GW, SO, False),
+    # ... red to red: courses within 22.5° of reciprocal, one of them within 22.5° of her bow
+    # (San Diego's SAILEBRATE and SHELTER ISLAND: 352.9°, 335.2°), and just outside each
+    (352.9, 335.2, HEAD_ON, GW, GW, False),
+    (350.0, 327.5, HEAD_ON, GW, GW, False),
+    (350.0, 327.5 - EPS, CROSSING, GW, SO, False),
+    (337.5 - EPS, 320.0, CROSSING, GW, SO, False),
+    # ... green to green the doubt stays narrow: both within 22.5° of the bow
+    (10.0, 32.5, CROSSING, SO, GW, False),
     # overtaking: strictly more than 22.5° abaft the beam, (112.5°, 247.5°)
     (0.0, 112.5 + EPS, OVERTAKING, GW, SO, True),
     (0.0, 112.5, CROSSING, SO, GW, False),

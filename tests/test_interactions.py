@@ -33,6 +33,7 @@ from colregs9_cli.core.interactions import (
     InteractionParams,
     VesselFacts,
     classify_interaction,
+    under_way_from,
     window_steps,
 )
 from colregs9_cli.core.pair import pair_tracks
@@ -624,3 +625,46 @@ def test_every_san_diego_pair(sandiego: dict[tuple[int, int], Interaction]) -> N
     assert sandiego[338330158, 368059810].basis.startswith(
         "338330158 moved 9 m in 180 s from -60 s (< 1 kn over ground; reports SOG 0.5 kn)"
     )
+
+
+# --- a pair not making way at its trigger, under way later in the passing -------------------
+
+
+def test_under_way_from_finds_where_both_make_way_for_the_rest_span() -> None:
+    # At her berth until 80 s, then away to 10 kn; the other vessel at 10 kn throughout.
+    leaving = path(
+        (0.0, 0.0), [(80, 90.0, 0.0), *((10, 90.0, 0.5 + k) for k in range(10)), (220, 90.0, 10.0)]
+    )
+    arriving = path((150.0, 1900.0), [(400, 270.0, 10.0)])
+    series = pair_series(leaving, arriving)
+    first, held = under_way_from(series, (VesselFacts(1), VesselFacts(2)), PARAMS, 1.0)
+    # 1 kn over ground, measured over 30 s centred on each step, is reached after 80 s
+    assert 80 < first < 100
+    assert held - first == math.ceil(PARAMS.at_rest_min_s)
+    # ... and a vessel that never leaves her berth never is
+    moored = path((0.0, 0.0), [(400, 90.0, 0.0)])
+    assert (
+        under_way_from(pair_series(moored, arriving), (VesselFacts(1), VesselFacts(2)), PARAMS, 1.0)
+        is None
+    )
+
+
+def test_dma_the_helsingor_ferries_are_judged_when_both_are_under_way(dma_nmea_replay) -> None:
+    # 219622000 lay at her berth at the trigger (12:00:39) and left it at about 12:00:45; at
+    # 12:02:26-34 both ferries made 9-10 kn 153-175 m apart: judged from when both made way.
+    (summary,) = (
+        p.summary
+        for p in dma_nmea_replay.pairs
+        if {p.summary.mmsi_a, p.summary.mmsi_b} == {219230000, 219622000}
+    )
+    assert summary.interaction == "encounter"
+    assert summary.interaction_basis.startswith("judged from 12:01:09, both under way")
+    assert summary.trigger_utc == pd.Timestamp("2013-11-12 12:01:09", tz="UTC")
+    assert summary.situation == "crossing"
+    # a pair that stays at rest keeps its kind: the moored pair at Svendborg
+    (moored,) = (
+        p.summary
+        for p in dma_nmea_replay.pairs
+        if {p.summary.mmsi_a, p.summary.mmsi_b} == {265518160, 265548350}
+    )
+    assert moored.interaction == "not-making-way"

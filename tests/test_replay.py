@@ -168,13 +168,19 @@ def test_national_sample_seats_agree(national) -> None:
     assert len(pairs) == NATIONAL_TRIGGERED // 2
     assert set(pairs["pair_id"]) == set(table["pair_id"])
     # Two pairs that once got contradictory roles (bearings 353.9°/352.5° and 31.4°/10.0°)
-    # are not encounters at all: ferries at their berths at Helsingør, and two vessels at rest
-    # in the Kiel Canal, one of them reporting 0.7–1.8 kn while her fixes moved 5 m.
+    # at their triggers: two vessels at rest in the Kiel Canal, one of them reporting
+    # 0.7–1.8 kn while her fixes moved 5 m, are no encounter at all ...
     by_pair = pairs.set_index(["mmsi_a", "mmsi_b"])
-    for pair in (("219230000", "219622000"), ("211440340", "211457700")):
-        assert by_pair.loc[pair, "interaction"] == "not-making-way"
-        assert by_pair.loc[pair, "situation"] == ""
-        assert by_pair.loc[pair, "give_way_vessels"] == ""
+    canal = by_pair.loc[("211440340", "211457700")]
+    assert canal["interaction"] == "not-making-way"
+    assert canal["situation"] == canal["give_way_vessels"] == ""
+    # ... and the Helsingør ferries, one at her berth at the trigger, are judged once both
+    # are under way: one situation, one give-way vessel.
+    ferries = by_pair.loc[("219230000", "219622000")]
+    assert ferries["interaction"] == "encounter"
+    assert ferries["interaction_basis"].startswith("judged from 12:01:09, both under way")
+    assert ferries["situation"] == "crossing"
+    assert ferries["give_way_vessels"] == "219230000"
 
 
 def test_no_audit_fact_is_judged_on_data_that_stops(national) -> None:

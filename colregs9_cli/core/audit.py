@@ -151,6 +151,20 @@ def observed_rows(
         return (nearest < step_s) | (gap <= params.observed_gap_max_s)
 
 
+def course_drawn_through_a_turn(
+    report_gap_s: ArrayLike, gap_turn_deg: ArrayLike, params: ConductParams
+) -> np.ndarray:
+    """The rows where a vessel's course is interpolated across a gap between two of her
+    reports longer than ``observed_gap_max_s`` in which she turned by ``course_change_deg``
+    or more: a straight line drawn through her turn, no observation of her heading (San
+    Diego: SHELTER ISLAND reported 087° and, three minutes later, 126°; the crossing read
+    from the 113° between was a meeting at the later report)."""
+    gap = np.asarray(report_gap_s, dtype=float)
+    turn = np.asarray(gap_turn_deg, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return (gap > params.observed_gap_max_s) & (turn >= params.course_change_deg)
+
+
 def conduct(
     course_deg: ArrayLike,
     sog_kn: ArrayLike,

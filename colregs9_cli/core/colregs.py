@@ -16,7 +16,14 @@ seats swaps the roles and nothing else. In order of precedence:
 3. **head-on** (rule 14): each is within ±``head_on_half_angle_deg`` of the other's bow. Both
    give way. Rule 14(c), in doubt assume head-on: each vessel sees the other on the *same*
    side (both on the starboard bow or both on the port bow), each within
-   ``head_on_doubt_deg`` of her bow; such courses are within that angle of reciprocal.
+   ``head_on_doubt_deg`` of her bow; such courses are within that angle of reciprocal. Red
+   to red (each on the other's port side) the doubt reaches further: courses within
+   ``head_on_doubt_deg`` of reciprocal with one vessel seeing the other within that angle of
+   her bow (San Diego: SAILEBRATE saw SHELTER ISLAND 7° on her port bow, SHELTER ISLAND
+   saw her 25° on hers, courses 18° off reciprocal). Rule 15 names neither vessel there (none
+   has the other on her starboard side), and a turn to starboard by both, which rule 14
+   asks, widens a port-to-port pass; green to green the same two turns would close it, so
+   the starboard side keeps the narrower doubt.
 4. **crossing** (rule 15), everything else: exactly one vessel gives way, the one that has the
    other on her starboard side. When the two see each other on the same side (or on a
    fore-and-aft line), rule 15's words name both or neither; the vessel whose bearing is
@@ -50,7 +57,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..config import dataclass_from_table
 from ..errors import ParameterError
 from ..geo import course_in_tangent_plane, velocity_mps
-from ..units import MPS_PER_KNOT, wrap_deg
+from ..units import MPS_PER_KNOT, signed_angle_deg, wrap_deg
 from .tracks import CourseSource
 
 
@@ -311,10 +318,13 @@ def _sectors(
     head_on_sectors = within_of_bow(beta, params.head_on_half_angle_deg) & within_of_bow(
         beta_prime, params.head_on_half_angle_deg
     )
-    in_doubt = (
-        (own_side == target_side)
-        & within_of_bow(beta, params.head_on_doubt_deg)
-        & within_of_bow(beta_prime, params.head_on_doubt_deg)
+    doubt = params.head_on_doubt_deg
+    near_bow = within_of_bow(beta, doubt), within_of_bow(beta_prime, doubt)
+    with np.errstate(invalid="ignore"):
+        near_reciprocal = np.abs(signed_angle_deg(beta - beta_prime)) <= doubt
+    red_to_red = (own_side < 0) & (target_side < 0)
+    in_doubt = ((own_side == target_side) & near_bow[0] & near_bow[1]) | (
+        red_to_red & near_reciprocal & (near_bow[0] | near_bow[1])
     )
     tie = ~opposite & (own_distance == target_distance)
     head_on = open_water & (head_on_sectors | in_doubt | tie)

@@ -283,6 +283,43 @@ def classify_interaction(
     return Interaction(InteractionKind.ENCOUNTER, basis, int(near.steps[0]), int(near.steps[-1]))
 
 
+def under_way_from(
+    series: pd.DataFrame,
+    facts: tuple[VesselFacts, VesselFacts],
+    params: InteractionParams,
+    step_s: float,
+) -> tuple[int, int] | None:
+    """Where both vessels are under way, in rows of ``series`` (from a pair's trigger on):
+    the first row from which both make way over ground (``making_way_kn``, measured as the
+    tests measure it) on consecutive steps, and the row at which they have done so for
+    ``at_rest_min_s``. A pair judged not making way at its trigger may meet under way later
+    in the same passing: a ferry leaving her berth (DMA: 219622000 at Helsingør, at her
+    berth at the trigger, 12:00:39, away at 12:00:45, at 9-10 kn 155 m from the other ferry
+    at 12:02:30). None when they never do so for that long."""
+    known = np.ones(len(series), dtype=bool)
+    for column in ("own_lat_deg", "own_lon_deg", "target_lat_deg", "target_lon_deg"):
+        known &= np.isfinite(series[column].to_numpy(dtype=float))
+    steps = series["step"].to_numpy(dtype=np.int64)
+    consecutive = np.r_[True, np.diff(steps) == 1]
+    usable = known & np.logical_and.accumulate(consecutive)
+    rows = np.flatnonzero(usable)
+    if len(rows) < 2 or rows[0] != 0:
+        return None
+    part = series.iloc[: rows[-1] + 1]
+    span = max(1, round(params.speed_span_s / step_s / 2.0))
+    speeds = [
+        _vessel(part, prefix, fact, seat, span, step_s).speed_kn
+        for prefix, fact, seat in zip(("own_", "target_"), facts, "ab", strict=True)
+    ]
+    making_way = (speeds[0] >= params.making_way_kn) & (speeds[1] >= params.making_way_kn)
+    held_steps = math.ceil(params.at_rest_min_s / step_s - 1e-9)
+    edges = np.diff(np.r_[0, making_way.astype(np.int8), 0])
+    for start, end in zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1, strict=True):
+        if end - start >= held_steps:
+            return int(start), int(start) + held_steps
+    return None
+
+
 # -- the window -----------------------------------------------------------------------------
 
 

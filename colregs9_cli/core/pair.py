@@ -39,7 +39,7 @@ from ..charts.channels import Channels
 from ..charts.water import Chart
 from ..geo import sail
 from .ais_claims import NavStatus, NavStatusBelief, NavStatusParams, nav_status_belief
-from .audit import ConductParams, Fact
+from .audit import ConductParams, Fact, course_drawn_through_a_turn
 from .channel_audit import (
     ChannelAuditParams,
     VesselInChannel,
@@ -59,10 +59,12 @@ from .confinement import DraughtOnChart
 from .encounters import Encounter, encounter_series
 from .interactions import (
     Interaction,
+    InteractionKind,
     InteractionParams,
     VesselFacts,
     approach_steps,
     classify_interaction,
+    under_way_from,
     window_steps,
 )
 from .manoeuvrability import (
@@ -259,18 +261,16 @@ def _held(g_a: ColregsEvaluation, meeting_in_channel: bool = False) -> ColregsEv
 
 
 def _course_drawn_across_a_turn(series: pd.DataFrame, conduct: ConductParams) -> np.ndarray:
-    """Steps where either vessel's course is interpolated across a report gap longer than
-    ``observed_gap_max_s`` in which she turned by at least ``course_change_deg``: the course
-    that placed her in a sector is a straight line drawn through her turn (San Diego:
-    SHELTER ISLAND reported 087° and, three minutes later, 126°; the crossing read from the
-    113° between was a meeting at the later report)."""
-    drawn = np.zeros(len(series), dtype=bool)
-    for prefix in PREFIXES:
-        with np.errstate(invalid="ignore"):
-            drawn |= (
-                series[f"{prefix}report_gap_s"].to_numpy(dtype=float) > conduct.observed_gap_max_s
-            ) & (series[f"{prefix}gap_turn_deg"].to_numpy(dtype=float) >= conduct.course_change_deg)
-    return drawn
+    """Steps where either vessel's course is drawn through a turn
+    (``audit.course_drawn_through_a_turn``)."""
+    return np.logical_or.reduce(
+        [
+            course_drawn_through_a_turn(
+                series[f"{prefix}report_gap_s"], series[f"{prefix}gap_turn_deg"], conduct
+            )
+            for prefix in PREFIXES
+        ]
+    )
 
 
 def _pair_steps(
@@ -360,7 +360,8 @@ def evaluate_pair(
         to_step=max(encounter.end_step, encounter.trigger_step + horizon),
     )
     full = full.iloc[: _contiguous_rows(full["step"].to_numpy())].reset_index(drop=True)
-    window = full[full["step"] >= encounter.trigger_step].reset_index(drop=True)
+    trigger_step, interaction = _judged_trigger(tracks, oriented, full, params)
+    window = full[full["step"] >= trigger_step].reset_index(drop=True)
     seen = passing(window["range_m"].to_numpy(), params.passing)
     # G_a and G_d run until the pair is past: until the range has opened clearly past its
     # least value (core/passing.py), or the data ends.
@@ -391,7 +392,6 @@ def evaluate_pair(
     )
     bends = (in_channel[0].bend_deg, in_channel[1].bend_deg)
     audit = audit_pair(window, seen, hulls, lengths_m, params.conduct, step_s, bends)
-    interaction = _interaction(tracks, oriented, encounter.trigger_step, params.interactions)
     meeting = meeting_along_a_channel(
         (in_channel[0], in_channel[1]),
         (float(series["own_cog_deg"].iloc[0]), float(series["target_cog_deg"].iloc[0])),
@@ -429,10 +429,71 @@ def evaluate_pair(
         restricted_nav_statuses=params.rule9.restricted_nav_statuses,
         interaction=interaction,
         swing_model=params.manoeuvrability.swing_model,
-        course_judged_above_kn=params.conduct.course_judged_above_kn,
+        conduct_params=params.conduct,
         in_channel=(in_channel[0], in_channel[1]),
         standings=standings,
     )
+
+
+def _judged_trigger(
+    tracks: Tracks, pair: Encounter, full: pd.DataFrame, params: PairParams
+) -> tuple[int, Interaction]:
+    """The step the pair is judged at, and its interaction there: the search's trigger,
+    unless a vessel was not making way there and, later in the same passing, both are under
+    way (``interactions.under_way_from``) at a step where the trigger's conditions hold
+    (0 <= TCPA <= ``tcpa_act_s``, CPA < ``cpa_req_m``) and the pair, judged from when both
+    made way, is no longer not making way: then that step, where the rules first bind. A
+    ferry leaving her berth is judged on her meeting under way, not on her berth. ``full``
+    is the pair's series up to the last step the evaluation reads, so that the step found
+    is the same whatever slab or worker evaluates the pair."""
+    assert pair.trigger_step is not None
+    interaction = _interaction(tracks, pair, pair.trigger_step, params.interactions)
+    if interaction.kind is not InteractionKind.NOT_MAKING_WAY:
+        return pair.trigger_step, interaction
+    window = full[full["step"] >= pair.trigger_step].reset_index(drop=True)
+    facts = _facts(tracks, pair)
+    under_way = under_way_from(window, facts, params.interactions, tracks.step_s)
+    if under_way is None:
+        return pair.trigger_step, interaction
+    first, held = under_way
+    seen = passing(window["range_m"].to_numpy(), params.passing)
+    tcpa_s = window["tcpa_s"].to_numpy(dtype=float)
+    cpa_m = window["cpa_m"].to_numpy(dtype=float)
+    rows = np.arange(len(window))
+    with np.errstate(invalid="ignore"):
+        fires = (
+            (rows >= held)
+            & (rows <= seen.end_row)
+            & (tcpa_s >= 0.0)
+            & (tcpa_s <= params.encounters.tcpa_act_s)
+            & (cpa_m < params.encounters.cpa_req_m)
+        )
+    if not fires.any():
+        return pair.trigger_step, interaction
+    row = int(np.flatnonzero(fires)[0])
+    later = classify_interaction(
+        window.iloc[first:].reset_index(drop=True),
+        row - first,
+        facts,
+        params.interactions,
+        tracks.step_s,
+        float(tcpa_s[row]),
+    )
+    if later.kind is InteractionKind.NOT_MAKING_WAY:
+        return pair.trigger_step, interaction
+    basis = (
+        f"judged from {window['timestamp'].iloc[row]:%H:%M:%S}, both under way "
+        f"(at {window['timestamp'].iloc[0]:%H:%M:%S} {interaction.basis}): {later.basis}"
+    )
+    return int(window["step"].iloc[row]), dataclasses.replace(later, basis=basis)
+
+
+def _facts(tracks: Tracks, pair: Encounter) -> tuple[VesselFacts, VesselFacts]:
+    a, b = (
+        VesselFacts.from_static(mmsi, _static(tracks.vessels, mmsi))
+        for mmsi in (pair.own_mmsi, pair.target_mmsi)
+    )
+    return a, b
 
 
 def _interaction(
@@ -449,12 +510,8 @@ def _interaction(
         to_step=trigger_step + lead + approach_steps(approach_s, tracks.step_s),
     ).reset_index(drop=True)
     trigger_row = int(np.searchsorted(around["step"].to_numpy(), trigger_step))
-    facts = tuple(
-        VesselFacts.from_static(mmsi, _static(tracks.vessels, mmsi))
-        for mmsi in (pair.own_mmsi, pair.target_mmsi)
-    )
     return classify_interaction(
-        around, trigger_row, (facts[0], facts[1]), params, tracks.step_s, approach_s
+        around, trigger_row, _facts(tracks, pair), params, tracks.step_s, approach_s
     )
 
 

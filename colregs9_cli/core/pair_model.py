@@ -23,9 +23,11 @@ import pandas as pd
 from .ais_claims import NavStatusBelief
 from .audit import (
     Conduct,
+    ConductParams,
     Fact,
     action_as_rule_asks,
     all_of,
+    course_drawn_through_a_turn,
     passed_port_to_port,
     stand_on_turned_to_port_for_vessel_on_port,
 )
@@ -104,7 +106,7 @@ class PairEvaluation:
     restricted_nav_statuses: frozenset[int]
     interaction: Interaction
     swing_model: SwingModel
-    course_judged_above_kn: float  # ``ConductParams``': below it a COG is noise
+    conduct_params: ConductParams  # what a course observed means (``audit.py``)
     # Each vessel and the charted channels (channel_audit.py), vessel order, and what rule 9's
     # clauses read of them (None: the chart charts no channel).
     in_channel: tuple[VesselInChannel, VesselInChannel] = (NOT_CHARTED, NOT_CHARTED)
@@ -201,11 +203,19 @@ class PairEvaluation:
         if not self.audit.covers_cpa or self.audit.cpa_utc is None:
             return Fact.INSUFFICIENT
         row = int(np.flatnonzero((times == self.audit.cpa_utc).to_numpy())[0])
-        speeds_kn = [float(self.steps.series[f"{prefix}sog_kn"].iloc[row]) for prefix in PREFIXES]
+        there = self.steps.series.iloc[[row]]
+        params = self.conduct_params
+        judged = all(
+            float(there[f"{prefix}sog_kn"].iloc[0]) >= params.course_judged_above_kn
+            and not course_drawn_through_a_turn(
+                there[f"{prefix}report_gap_s"], there[f"{prefix}gap_turn_deg"], params
+            )[0]
+            for prefix in PREFIXES
+        )
         return passed_port_to_port(
             situation,
             (float(self.steps.g_a.beta_deg[row]), float(self.steps.g_a.beta_prime_deg[row])),
-            all(speed >= self.course_judged_above_kn for speed in speeds_kn),
+            judged,
         )
 
     @property
