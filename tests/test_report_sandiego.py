@@ -96,6 +96,27 @@ def test_the_figure_draws_only_the_chart_in_its_view(sandiego) -> None:
     assert _collection(ax, "not-charted") is None
 
 
+def test_the_map_frames_the_passing_not_the_whole_run(sandiego) -> None:
+    # SHELTER ISLAND and SAILEBRATE passed at 55 m at 00:01:34; SHELTER ISLAND's track runs
+    # on for 8 km until 00:11. The map is drawn at the scale of the pass.
+    result, chart = sandiego
+    outcome = _outcome(result, "20220103T000012-338187796-338254678")
+    figure = encounter_figure(outcome, chart, ukc_m=0.0, frame=result.frame)
+    ax = figure.axes[0]
+    (x_low, x_high), (y_low, y_high) = ax.get_xlim(), ax.get_ylim()
+    assert x_high - x_low < 1000.0
+    track = outcome.own_track.dropna(subset=["east_m"])
+    assert np.ptp(track["east_m"]) > 5000.0  # drawn whole, cut by the view
+    for part in (outcome.own_track, outcome.target_track):
+        times = pd.to_datetime(part["timestamp"], utc=True)
+        passing = part[
+            (times >= outcome.series["timestamp"].min())
+            & (times <= outcome.series["timestamp"].max())
+        ]
+        assert ((passing["east_m"] >= x_low) & (passing["east_m"] <= x_high)).all()
+        assert ((passing["north_m"] >= y_low) & (passing["north_m"] <= y_high)).all()
+
+
 def test_water_beyond_the_chart_is_marked_not_charted(sandiego) -> None:
     result, chart = sandiego
     outcome = _outcome(result, LEAVES_THE_CHART)

@@ -102,20 +102,34 @@ def verdict_text(outcome: EncounterOutcome) -> str:
     )
 
 
+def _passing_part(track: pd.DataFrame, outcome: EncounterOutcome) -> pd.DataFrame:
+    """The rows of a track from the trigger to the end of the passing (the series' span)."""
+    times = pd.to_datetime(track["timestamp"], utc=True)
+    series_times = pd.to_datetime(outcome.series["timestamp"], utc=True)
+    return track[(times >= series_times.min()) & (times <= series_times.max())]
+
+
 def _view_box(outcome: EncounterOutcome) -> Bounds:
-    """A square around the tracks, the positions at TCPA and the arcs, not the whole chart."""
+    """A square around the passing: both tracks from the trigger to the pass, the positions
+    predicted at TCPA and the arcs; not the whole chart, nor the whole candidate run (two
+    yachts that passed at 55 m within an 8 km run are drawn at the scale of their pass). The
+    tracks are drawn whole and cut by the view."""
+    own, target = (
+        _passing_part(outcome.own_track, outcome),
+        _passing_part(outcome.target_track, outcome),
+    )
     east = np.concatenate(
         [
-            outcome.own_track["east_m"].to_numpy(),
-            outcome.target_track["east_m"].to_numpy(),
+            own["east_m"].to_numpy(),
+            target["east_m"].to_numpy(),
             [outcome.own_at_tcpa_m[1], outcome.target_at_tcpa_m[1]],
             outcome.assessment.east_m if outcome.in_run_frame else [],
         ]
     )
     north = np.concatenate(
         [
-            outcome.own_track["north_m"].to_numpy(),
-            outcome.target_track["north_m"].to_numpy(),
+            own["north_m"].to_numpy(),
+            target["north_m"].to_numpy(),
             [outcome.own_at_tcpa_m[0], outcome.target_at_tcpa_m[0]],
             outcome.assessment.north_m if outcome.in_run_frame else [],
         ]
