@@ -517,3 +517,36 @@ def test_a_course_is_drawn_through_a_turn_only_across_a_long_gap_with_a_turn() -
         False,  # less than an action's turn
         False,
     ]
+
+
+def test_a_change_across_the_gap_that_holds_the_closest_approach_is_unknown() -> None:
+    # reports at rows 0-2; the closest approach (row 4) is drawn inside a long gap that
+    # ends at row 6, where her course has turned 50 deg: she may have turned before it
+    observed = np.array([True, True, True, False, False, False, True])
+    course = np.array([10.0, 10.0, 10.0, 0.0, 350.0, 340.0, 320.0])
+    speed = np.full(7, 6.0)
+    result = conduct(course, speed, PARAMS, observed, last_row=4)
+    assert (result.changed, result.action) == (Fact.INSUFFICIENT, Action.INSUFFICIENT)
+    # the same gap with no change across it: she kept her course
+    steady = np.full(7, 10.0)
+    assert conduct(steady, speed, PARAMS, observed, last_row=4).action is Action.NONE
+    # an action seen at a report before the gap is her first action whatever came after
+    turned = np.array([10.0, 40.0, 40.0, 30.0, 20.0, 10.0, 0.0])
+    first = conduct(turned, speed, PARAMS, observed, last_row=4)
+    assert (first.action, first.action_row) == (Action.STARBOARD_TURN, 1)
+    # the closest approach at a report: the rows after it are not read
+    at_report = conduct(course, speed, PARAMS, np.ones(7, bool), last_row=2)
+    assert at_report.action is Action.NONE
+
+
+def test_sandiego_a_turn_that_may_have_come_before_the_closest_approach(sandiego_replay) -> None:
+    # WELL PLAYED reported 009.5 deg at 00:12:56 and 318.7 deg at 00:14:27; the least
+    # separation with TRADITION was drawn at 00:14:06, between the two.
+    well_played, tradition = 338307872, 338403914
+    (summary,) = (
+        p.summary
+        for p in sandiego_replay.pairs
+        if {p.summary.mmsi_a, p.summary.mmsi_b} == {well_played, tradition}
+    )
+    assert summary.mmsi_a == well_played
+    assert summary.action_a == "insufficient-data"

@@ -22,6 +22,8 @@ from colregs9_cli.core.tracks import CourseSource
 from colregs9_cli.errors import ParameterError, QueryError
 
 PARAMS = ColregsParams()
+# The sectors alone: no bearing moved by a margin, so no reading in doubt (rules 13(c), 14(c)).
+SECTORS = ColregsParams(ambiguity_margin_deg=0.0)
 EPS = 1e-6
 GW, SO, NO = Role.GIVE_WAY, Role.STAND_ON, Role.NONE
 HEAD_ON, CROSSING, OVERTAKING, NONE = (
@@ -107,16 +109,55 @@ def test_boundaries_while_closing(
     target_role: Role,
     own_overtaking: bool,
 ) -> None:
-    result = classify(beta, beta_prime, True, PARAMS)
+    result = classify(beta, beta_prime, True, SECTORS)
     assert result.situation[0] is situation
     assert result.own_role[0] is own_role
     assert result.target_role[0] is target_role
     assert bool(result.own_overtaking[0]) is own_overtaking
     # the other seat: the same situation, the roles swapped
-    other = classify(beta_prime, beta, True, PARAMS)
+    other = classify(beta_prime, beta, True, SECTORS)
     assert other.situation[0] is situation
     assert (other.own_role[0], other.target_role[0]) == (target_role, own_role)
     assert other.ambiguous[0] == result.ambiguous[0]
+
+
+# Read in doubt (rules 14(c) and 13(c)): a crossing that a 3 deg move of the bearings makes
+# head-on, or an overtaking by one vessel, is that (β, β', situation, own, target, basis).
+IN_DOUBT_CASES = [
+    # San Diego, TRADITION and CHAMPAGNE: 6.06 deg off one bow, 2.7 deg off the other
+    (353.94, 2.72, HEAD_ON, GW, GW, SituationBasis.HEAD_ON_IN_DOUBT),
+    (6.0 + EPS, 0.0, HEAD_ON, GW, GW, SituationBasis.HEAD_ON_IN_DOUBT),
+    (22.5 + EPS, 10.0, HEAD_ON, GW, GW, SituationBasis.HEAD_ON_IN_DOUBT),
+    # beyond the margin: a crossing
+    (9.5, 350.5, CROSSING, GW, SO, None),
+    (0.0, 112.5, OVERTAKING, GW, SO, SituationBasis.OVERTAKING_IN_DOUBT),
+    (247.5, 0.0, OVERTAKING, SO, GW, SituationBasis.OVERTAKING_IN_DOUBT),
+    (0.0, 109.5 - EPS, CROSSING, SO, GW, None),
+]
+
+
+@pytest.mark.parametrize(
+    ("beta", "beta_prime", "situation", "own_role", "target_role", "basis"), IN_DOUBT_CASES
+)
+def test_a_vessel_in_doubt_assumes_head_on_or_overtaking(
+    beta: float,
+    beta_prime: float,
+    situation: Situation,
+    own_role: Role,
+    target_role: Role,
+    basis: SituationBasis | None,
+) -> None:
+    for seat, (b, b_prime), roles in (
+        ("a", (beta, beta_prime), (own_role, target_role)),
+        ("b", (beta_prime, beta), (target_role, own_role)),
+    ):
+        result = classify(b, b_prime, True, PARAMS)
+        assert result.situation[0] is situation, seat
+        assert (result.own_role[0], result.target_role[0]) == roles, seat
+        if basis is not None:
+            assert result.basis[0] is basis and result.ambiguous[0], seat
+    # the sectors alone keep the crossing
+    assert classify(beta, beta_prime, True, SECTORS).situation[0] is CROSSING
 
 
 @pytest.mark.parametrize(("beta", "beta_prime"), [(c[0], c[1]) for c in BOUNDARY_CASES])
@@ -145,8 +186,9 @@ def test_configured_angles_move_the_boundaries() -> None:
         head_on_doubt_deg=10.0,
         overtaking_sector_min_deg=100.0,
         overtaking_sector_max_deg=260.0,
+        ambiguity_margin_deg=0.0,
     )
-    no_doubt = ColregsParams(head_on_doubt_deg=6.0)
+    no_doubt = ColregsParams(head_on_doubt_deg=6.0, ambiguity_margin_deg=0.0)
     assert classify(8.0, 8.0, True, wide).situation[0] is HEAD_ON
     assert classify(8.0, 3.0, True, no_doubt).situation[0] is CROSSING
     assert classify(8.0, 3.0, True, PARAMS).situation[0] is HEAD_ON  # in doubt
@@ -324,19 +366,15 @@ def test_geometric_situations(
 def test_course_source_heading_changes_the_bearings() -> None:
     own = ship(0, 0, 0.0, 5.0)
     crabbing = ship(1000, 0, 180.0, 5.0, heading=170.0)  # moves south, bow 10° to port of it
-    by_cog = evaluate_colregs(own, crabbing, PARAMS)
-    by_heading = evaluate_colregs(own, crabbing, ColregsParams(course_source=CourseSource.HEADING))
+    by_cog = evaluate_colregs(own, crabbing, SECTORS)
+    heading = ColregsParams(course_source=CourseSource.HEADING, ambiguity_margin_deg=0.0)
+    by_heading = evaluate_colregs(own, crabbing, heading)
     assert by_cog.situation[0] is HEAD_ON
     assert by_heading.beta_prime_deg[0] == pytest.approx(10.0)
     assert by_heading.situation[0] is CROSSING
     assert (by_heading.own_role[0], by_heading.target_role[0]) == (SO, GW)
     no_heading = ship(1000, 0, 180.0, 5.0)
-    assert (
-        evaluate_colregs(
-            own, no_heading, ColregsParams(course_source=CourseSource.HEADING)
-        ).situation[0]
-        is HEAD_ON
-    )
+    assert evaluate_colregs(own, no_heading, heading).situation[0] is HEAD_ON
 
 
 def test_vectorised_over_steps() -> None:

@@ -660,7 +660,8 @@ def test_dma_the_helsingor_ferries_are_judged_when_both_are_under_way(dma_nmea_r
     assert summary.interaction == "encounter"
     assert summary.interaction_basis.startswith("judged from 12:01:09, both under way")
     assert summary.trigger_utc == pd.Timestamp("2013-11-12 12:01:09", tz="UTC")
-    assert summary.situation == "crossing"
+    # 6.8 deg off one bow, 2.3 deg off the other: head-on in doubt (rule 14(c))
+    assert (summary.situation, summary.situation_basis) == ("head-on", "head-on in doubt")
     # a pair that stays at rest keeps its kind: the moored pair at Svendborg
     (moored,) = (
         p.summary

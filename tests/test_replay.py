@@ -175,12 +175,12 @@ def test_national_sample_seats_agree(national) -> None:
     assert canal["interaction"] == "not-making-way"
     assert canal["situation"] == canal["give_way_vessels"] == ""
     # ... and the Helsingør ferries, one at her berth at the trigger, are judged once both
-    # are under way: one situation, one give-way vessel.
+    # are under way: meeting nearly end on, each gives way (rule 14(c)).
     ferries = by_pair.loc[("219230000", "219622000")]
     assert ferries["interaction"] == "encounter"
     assert ferries["interaction_basis"].startswith("judged from 12:01:09, both under way")
-    assert ferries["situation"] == "crossing"
-    assert ferries["give_way_vessels"] == "219230000"
+    assert (ferries["situation"], ferries["situation_basis"]) == ("head-on", "head-on in doubt")
+    assert ferries["give_way_vessels"] == "219230000;219622000"
 
 
 def test_no_audit_fact_is_judged_on_data_that_stops(national) -> None:

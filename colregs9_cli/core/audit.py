@@ -27,7 +27,11 @@ before the closest approach the answer is ``insufficient-data``, never ``false``
   is her first observed row. When the trigger falls inside a longer gap and her course or
   speed changed across it (the trigger's interpolated values against the gap's closing
   report), the change may have come before the trigger or after it: her conduct is
-  ``insufficient-data``.
+  ``insufficient-data``. Likewise at the other end: when the closest approach falls inside a
+  longer gap, no action was seen before it, and her course or speed changed across that gap
+  (her last report before it against her first after it), the change may have come before
+  the closest approach: ``insufficient-data`` (San Diego: WELL PLAYED reported 009° at
+  00:12:56 and 319° at 00:14:27, and the least separation was drawn at 00:14:06).
 - **The kind of action** (``action_as_rule_asks``). Whether the give-way vessel's action is
   the kind the deciding rule asks for (judged on her first action only):
 
@@ -170,22 +174,32 @@ def conduct(
     sog_kn: ArrayLike,
     params: ConductParams,
     observed: ArrayLike | None = None,
+    last_row: int | None = None,
 ) -> Conduct:
-    """One vessel's conduct over the rows given (the trigger to the closest approach).
+    """One vessel's conduct from the trigger (row 0) to the closest approach (``last_row``,
+    default the last row).
 
-    ``observed`` (``observed_rows``; default: every row) marks the rows her reports show."""
+    ``observed`` (``observed_rows``; default: every row) marks the rows her reports show.
+    Rows after ``last_row`` are read only to close a report gap that holds it."""
     course_all = np.asarray(course_deg, dtype=float)
     sog_all = np.asarray(sog_kn, dtype=float)
     seen = np.ones(len(sog_all), bool) if observed is None else np.asarray(observed, bool)
-    rows = np.flatnonzero(seen)
+    last = len(sog_all) - 1 if last_row is None else last_row
+    rows = np.flatnonzero(seen[: last + 1])
     if len(rows) == 0:
         return INSUFFICIENT_CONDUCT
     if rows[0] > 0 and _changed_between(course_all, sog_all, 0, int(rows[0]), params):
         return INSUFFICIENT_CONDUCT
     found = _conduct_at(course_all[rows], sog_all[rows], params)
-    if found.action_row is None:
-        return found
-    return Conduct(found.changed, found.action, int(rows[found.action_row]))
+    if found.action_row is not None:
+        return Conduct(found.changed, found.action, int(rows[found.action_row]))
+    if not seen[last]:
+        after = np.flatnonzero(seen[last + 1 :])
+        if not len(after) or _changed_between(
+            course_all, sog_all, int(rows[-1]), last + 1 + int(after[0]), params
+        ):
+            return INSUFFICIENT_CONDUCT
+    return found
 
 
 def _changed_between(

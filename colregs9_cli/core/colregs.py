@@ -33,6 +33,12 @@ seats swaps the roles and nothing else. In order of precedence:
 
 A situation is ``ambiguous`` when moving either bearing by ``ambiguity_margin_deg`` would change
 it or either role: it lies near a sector boundary, where the course noise of AIS can decide.
+The rules say how a vessel in doubt reads it: a crossing that such a move would make head-on
+is head-on (rule 14(c), "in any doubt ... assume that it does exist"; San Diego: TRADITION
+6.06° off CHAMPAGNE's bow, CHAMPAGNE 2.7° off hers, courses 9° off reciprocal), with
+``SituationBasis`` "head-on in doubt"; a crossing that such a move would make an overtaking
+by one vessel, and by her alone, is that overtaking (rule 13(c), "in any doubt ... assume
+that this is the case"), with "overtaking in doubt".
 ``evaluate_colregs`` also flags a step where either vessel's course is a COG below the speed at
 which COG is judged (``[replay] course_judged_above_kn``): her bearings are noise.
 ``SituationBasis`` records whether it rests on the sectors alone, on rule 14(c) or on the
@@ -73,6 +79,7 @@ class SituationBasis(StrEnum):
 
     SECTORS = "sectors"
     HEAD_ON_IN_DOUBT = "head-on in doubt"  # rule 14(c)
+    OVERTAKING_IN_DOUBT = "overtaking in doubt"  # rule 13(c)
     SAME_SIDE = "same-side crossing"  # rule 15 names both or neither; see the module docstring
     CHANNEL = "meeting along a charted channel"  # core/channel_audit.py: a bend is no crossing
     NONE = "none"
@@ -94,6 +101,7 @@ _BASES = np.array(
         SituationBasis.HEAD_ON_IN_DOUBT,
         SituationBasis.SAME_SIDE,
         SituationBasis.NONE,
+        SituationBasis.OVERTAKING_IN_DOUBT,
     ],
     dtype=object,
 )
@@ -345,6 +353,31 @@ def _sectors(
     return _Sectors(situation, own_gives_way, target_gives_way, basis)
 
 
+def _in_doubt(
+    result: _Sectors,
+    could_be_head_on: NDArray[np.bool_],
+    could_overtake: tuple[NDArray[np.bool_], NDArray[np.bool_]],
+) -> _Sectors:
+    """A crossing read as the vessels in doubt must read it (module docstring): head-on
+    where a move of the bearings by the margin makes it head-on (rule 14(c)), else an
+    overtaking where such a move makes one vessel, and only one, the overtaking one
+    (rule 13(c))."""
+    crossing = result.situation == 2
+    head_on = crossing & could_be_head_on
+    own_overtakes, target_overtakes = could_overtake
+    overtaking = crossing & ~head_on & (own_overtakes != target_overtakes)
+    return _Sectors(
+        situation=np.where(head_on, 1, np.where(overtaking, 0, result.situation)),
+        own_gives_way=np.where(
+            head_on, True, np.where(overtaking, own_overtakes, result.own_gives_way)
+        ),
+        target_gives_way=np.where(
+            head_on, True, np.where(overtaking, target_overtakes, result.target_gives_way)
+        ),
+        basis=np.where(head_on, 1, np.where(overtaking, 4, result.basis)),
+    )
+
+
 def classify(
     beta_deg: ArrayLike, beta_prime_deg: ArrayLike, closing: ArrayLike, params: ColregsParams
 ) -> ColregsEvaluation:
@@ -357,6 +390,11 @@ def classify(
     result = _sectors(beta, beta_prime, closing_now, params)
 
     ambiguous = np.zeros(result.situation.shape, dtype=bool)
+    could_be_head_on = np.zeros(result.situation.shape, dtype=bool)
+    could_overtake = (
+        np.zeros(result.situation.shape, dtype=bool),
+        np.zeros(result.situation.shape, dtype=bool),
+    )
     margin = params.ambiguity_margin_deg
     if margin > 0.0:
         for shift, shift_prime in itertools.product((-margin, 0.0, margin), repeat=2):
@@ -370,7 +408,11 @@ def classify(
                 | (moved.own_gives_way != result.own_gives_way)
                 | (moved.target_gives_way != result.target_gives_way)
             )
+            could_be_head_on |= moved.situation == 1
+            could_overtake[0][...] |= (moved.situation == 0) & moved.own_gives_way
+            could_overtake[1][...] |= (moved.situation == 0) & moved.target_gives_way
     ambiguous &= result.situation != 3
+    result = _in_doubt(result, could_be_head_on, could_overtake)
 
     def role(gives_way: NDArray[np.bool_]) -> NDArray[np.object_]:
         return _ROLES[np.where(result.situation == 3, 2, np.where(gives_way, 0, 1))]

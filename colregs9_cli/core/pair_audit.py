@@ -183,15 +183,18 @@ def _audit_conduct(
             hull_m,
             assumed,
         )
-    until = window.iloc[: cpa_row + 1]
     conducts = tuple(
         conduct(
-            _against_bend(until[f"{prefix}course_deg"].to_numpy(dtype=float), bends_deg, vessel),
-            until[f"{prefix}sog_kn"].to_numpy(dtype=float),
+            _against_bend(window[f"{prefix}course_deg"].to_numpy(dtype=float), bends_deg, vessel),
+            window[f"{prefix}sog_kn"].to_numpy(dtype=float),
             params,
             observed_rows(
-                until[f"{prefix}report_gap_s"], until[f"{prefix}nearest_report_s"], step_s, params
+                window[f"{prefix}report_gap_s"],
+                window[f"{prefix}nearest_report_s"],
+                step_s,
+                params,
             ),
+            last_row=cpa_row,
         )
         for vessel, prefix in enumerate(PREFIXES)
     )
@@ -212,10 +215,13 @@ def _audit_conduct(
 def _against_bend(
     course_deg: np.ndarray, bends_deg: tuple[np.ndarray, np.ndarray] | None, vessel: int
 ) -> np.ndarray:
-    """Her course less the channel's turn since the trigger, where she follows one."""
+    """Her course less the channel's turn since the trigger, where she follows one (rows
+    past the closest approach, read only to close its report gap, keep the turn there)."""
     if bends_deg is None:
         return course_deg
     bend = np.zeros(len(course_deg))
-    known = bends_deg[vessel][: len(course_deg)]
-    bend[: len(known)] = np.nan_to_num(known)
+    known = np.nan_to_num(bends_deg[vessel][: len(course_deg)])
+    bend[: len(known)] = known
+    if len(known):
+        bend[len(known) :] = known[-1]
     return course_deg - bend
