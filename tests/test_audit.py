@@ -6,6 +6,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
@@ -422,18 +423,31 @@ def test_sandiego_actions_inside_one_report_gap_are_not_judged(sandiego_replay) 
         assert "sped-up" not in summary.give_way_action
 
 
-def test_sandiego_a_course_drawn_through_a_turn_leaves_the_situation_in_doubt(
-    sandiego_replay,
-) -> None:
-    # SHELTER ISLAND reported 087.5 deg at 00:07:12 and 126.2 deg at 00:10:13; the crossing
-    # with WHITE NIGHTS was read from the 113 deg drawn between them at the trigger.
-    shelter_island, white_nights = 338187796, 338372419
-    (summary,) = (
-        p.summary
-        for p in sandiego_replay.pairs
-        if {p.summary.mmsi_a, p.summary.mmsi_b} == {shelter_island, white_nights}
-    )
-    assert summary.situation_ambiguous is True
+def test_sandiego_a_situation_is_read_where_both_courses_are_reported(sandiego_replay) -> None:
+    # SHELTER ISLAND reported 087.5 deg at 00:07:12 and 126.2 deg at 00:10:13; at the trigger
+    # (00:09:13) the 113 deg drawn between read a crossing with WHITE NIGHTS. At her report
+    # they met end on, and passed port to port.
+    def pair(a: int, b: int):
+        (found,) = (
+            p.summary
+            for p in sandiego_replay.pairs
+            if {p.summary.mmsi_a, p.summary.mmsi_b} == {a, b}
+        )
+        return found
+
+    shelter_island = pair(338187796, 338372419)
+    assert shelter_island.trigger_utc == pd.Timestamp("2022-01-03 00:09:13", tz="UTC")
+    assert shelter_island.situation_utc == pd.Timestamp("2022-01-03 00:10:13", tz="UTC")
+    assert shelter_island.situation == "head-on"
+    assert shelter_island.passed_port_to_port == "true"
+    # SAILEBRATE and ECHELON tack between reports up to the closest approach the trigger
+    # predicts: read at the trigger, and flagged
+    tacking = pair(338254678, 368124990)
+    assert tacking.situation_utc == tacking.trigger_utc
+    assert tacking.situation_ambiguous is True
+    # a course reported at the trigger: read there
+    champagne_leto = pair(367412850, 368103590)
+    assert champagne_leto.situation_utc == champagne_leto.trigger_utc
 
 
 @pytest.mark.parametrize("rule", [DecidingRule.RULE_13, DecidingRule.RULE_9, DecidingRule.RULE_18])

@@ -265,9 +265,12 @@ def test_national_time_series_runs_from_the_trigger_until_the_pass(national) -> 
             assert series["situation"].isna().all() and series["automaton_path"].isna().all()
             continue
         assert series["automaton_path"].iloc[0] == summary.automaton_path
-        # the situation is held from the trigger; the instantaneous one may change
+        # the situation is held from where it was read (the trigger, or the first step with
+        # both courses reported); the instantaneous one may change
         assert (series["situation"] == summary.situation.value).all()
-        assert series["situation_now"].iloc[0] == summary.situation.value
+        read_at = pd.to_datetime(series["timestamp"], utc=True) == summary.situation_utc
+        assert read_at.sum() == 1
+        assert series.loc[read_at, "situation_now"].iloc[0] == summary.situation.value
         if summary.data_covers_cpa:
             # the audit's closest approach is a row of the series
             closest = series["range_m"].idxmin()

@@ -365,17 +365,17 @@ def test_the_clause_of_rule_9_that_binds_the_other_vessel(restricted, other, cla
 
 def test_sandiego_rule_9_binds_no_one_outside_a_charted_channel(sandiego_replay) -> None:
     # SHELTER ISLAND, a 9 m yacht the estimator finds restricted by shoals outside any
-    # charted channel, meets WHITE NIGHTS proceeding along the main channel: rule 9 is about
-    # narrow channels, so with the chart's channels known it does not invert rule 15, under
-    # which SHELTER ISLAND, with WHITE NIGHTS on her starboard side, gives way.
+    # charted channel, meets WHITE NIGHTS proceeding along the main channel end on (read at
+    # her report at 00:10:13): rule 9 is about narrow channels, so with the chart's channels
+    # known it does not make WHITE NIGHTS give way to her alone; rule 14 has both give way.
     summaries = [p.summary for p in sandiego_replay.pairs]
     assert not any(s.rule9_applied for s in summaries)
     (s,) = [s for s in summaries if s.rule9_clause is not None]
     assert (s.name_a, s.name_b) == ("SHELTER ISLAND", "WHITE NIGHTS")
-    assert s.rule9_clause.value == "estimator" and s.deciding_rule.value == "15"
+    assert s.rule9_clause.value == "estimator" and s.deciding_rule.value == "14"
     assert s.estimated_restricted_a.value == "true" and s.channel_a is None
     assert s.channel_relation_b.value == "along"
-    assert (s.role_final_a.value, s.role_final_b.value) == ("give-way", "stand-on")
+    assert (s.role_final_a.value, s.role_final_b.value) == ("give-way", "give-way")
 
 
 @pytest.mark.parametrize(

@@ -232,23 +232,42 @@ def _state(series: pd.DataFrame, prefix: str) -> dict[str, np.ndarray]:
     }
 
 
-def _held(g_a: ColregsEvaluation, meeting_in_channel: bool = False) -> ColregsEvaluation:
-    """The trigger's situation and roles held at every step (rule 13(d)); the bearings and
-    closing flags stay those of each step. Two vessels meeting along a charted channel
-    (``channel_audit.meeting_along_a_channel``) that G_a reads as crossing, as a bend makes
-    their courses cross, are head-on."""
+def _situation_row(g_a: ColregsEvaluation, drawn: np.ndarray, last_row: int) -> int:
+    """The step the situation is read at: the trigger (row 0), unless a vessel's course
+    there is drawn through a turn between two of her reports (``_course_drawn_across_a_turn``);
+    then the first step, while the pair still closes and no later than ``last_row`` (the
+    closest approach the trigger predicts), at which neither course is (San Diego: SHELTER
+    ISLAND reported 087° and, three minutes later, 126°; at the later report she and WHITE
+    NIGHTS met end on, where the 113° drawn between read a crossing). Row 0 when there is
+    none: the situation stays the trigger's, flagged ambiguous."""
+    if not drawn[0]:
+        return 0
+    seen = np.flatnonzero(
+        ~drawn[: last_row + 1] & (g_a.situation[: last_row + 1] != Situation.NONE)
+    )
+    return int(seen[0]) if len(seen) else 0
+
+
+def _held(
+    g_a: ColregsEvaluation, meeting_in_channel: bool = False, row: int = 0
+) -> ColregsEvaluation:
+    """The situation and roles read at step ``row`` (``_situation_row``) held at every step
+    (rule 13(d)); the bearings and closing flags stay those of each step. Two vessels
+    meeting along a charted channel (``channel_audit.meeting_along_a_channel``) that G_a
+    reads as crossing, as a bend makes their courses cross, are head-on."""
     rows = len(g_a.situation)
+    read = slice(row, row + 1)
     held = ColregsEvaluation(
         **{
-            name: np.repeat(getattr(g_a, name)[:1], rows)
+            name: np.repeat(getattr(g_a, name)[read], rows)
             for name in ("situation", "own_role", "target_role", "own_overtaking", "ambiguous")
         },
-        basis=np.repeat(g_a.basis[:1], rows),
+        basis=np.repeat(g_a.basis[read], rows),
         beta_deg=g_a.beta_deg,
         beta_prime_deg=g_a.beta_prime_deg,
         closing=g_a.closing,
     )
-    if not (meeting_in_channel and g_a.situation[0] is Situation.CROSSING):
+    if not (meeting_in_channel and g_a.situation[row] is Situation.CROSSING):
         return held
     return dataclasses.replace(
         held,
@@ -289,12 +308,13 @@ def _pair_steps(
         params.colregs,
         course_judged_above_kn=params.conduct.course_judged_above_kn,
     )
+    drawn = _course_drawn_across_a_turn(series, params.conduct)
     g_a = dataclasses.replace(
-        g_a,
-        ambiguous=g_a.ambiguous
-        | (_course_drawn_across_a_turn(series, params.conduct) & (g_a.situation != Situation.NONE)),
+        g_a, ambiguous=g_a.ambiguous | (drawn & (g_a.situation != Situation.NONE))
     )
-    held = _held(g_a, meeting_in_channel)
+    predicted_cpa_row = math.ceil(max(float(series["tcpa_s"].iloc[0]), 0.0) / step_s)
+    situation_row = _situation_row(g_a, drawn, predicted_cpa_row)
+    held = _held(g_a, meeting_in_channel, situation_row)
     situation = held.situation[0]
     roles = (held.own_role[0], held.target_role[0])
     statuses = params.rule9.restricted_nav_statuses
@@ -332,6 +352,7 @@ def _pair_steps(
         series=series,
         g_a=g_a,
         held=held,
+        situation_row=situation_row,
         verdicts=verdicts,
         estimates=estimates,
         assessed_row=assessed_row,

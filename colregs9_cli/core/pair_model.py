@@ -82,7 +82,8 @@ class PairSteps:
 
     series: pd.DataFrame  # from the trigger to the pass, columns own_* = a, target_* = b
     g_a: ColregsEvaluation
-    held: ColregsEvaluation  # the trigger's situation, repeated
+    held: ColregsEvaluation  # the situation read at ``situation_row``, repeated
+    situation_row: int  # the trigger (0), or the first step with both courses reported
     verdicts: list[PairVerdict]
     estimates: tuple[list[Restriction], list[Restriction]]
     assessed_row: tuple[list[int], list[int]]
@@ -174,9 +175,11 @@ class PairEvaluation:
     def stand_on_turned_to_port(self) -> Fact | None:
         """Rule 17(c): the stand-on vessel of a crossing turned to port for a vessel on her own
         port side (``audit.stand_on_turned_to_port_for_vessel_on_port``); None where it does
-        not apply. The other vessel's bearing is the one at the trigger, from her course."""
+        not apply. The other vessel's bearing is the one where the situation was read, from
+        her course."""
         verdict = self.verdict
-        bearings = (self.steps.g_a.beta_deg[0], self.steps.g_a.beta_prime_deg[0])
+        row = self.steps.situation_row
+        bearings = (self.steps.g_a.beta_deg[row], self.steps.g_a.beta_prime_deg[row])
         facts = [
             stand_on_turned_to_port_for_vessel_on_port(
                 verdict.situation,
@@ -191,6 +194,12 @@ class PairEvaluation:
         ]
         judged = [fact for fact in facts if fact is not None]
         return all_of(judged) if judged else None
+
+    @property
+    def situation_utc(self) -> pd.Timestamp:
+        """When the situation was read: the trigger, or the first step after it with both
+        courses reported (``pair._situation_row``)."""
+        return pd.Timestamp(self.steps.series["timestamp"].iloc[self.steps.situation_row])
 
     @property
     def passed_port_to_port(self) -> Fact | None:

@@ -43,6 +43,7 @@ class PairSummary:
     situation: Situation | None
     situation_ambiguous: bool | None
     situation_basis: SituationBasis | None
+    situation_utc: pd.Timestamp | None
     role_colregs_a: Role | None
     role_colregs_b: Role | None
     nav_status_a: int | None
@@ -140,6 +141,7 @@ PAIR_VERDICT_COLUMNS: tuple[str, ...] = (
     "situation",
     "situation_ambiguous",
     "situation_basis",
+    "situation_utc",
     "role_colregs_a",
     "role_colregs_b",
     "estimated_restricted_a",
@@ -207,6 +209,7 @@ class EncounterSummary:
     situation: Situation | None
     situation_ambiguous: bool | None
     situation_basis: SituationBasis | None
+    situation_utc: pd.Timestamp | None
     own_role_colregs: Role | None
     target_role_colregs: Role | None
     own_nav_status: int | None
@@ -304,6 +307,7 @@ ENCOUNTER_VERDICT_COLUMNS: tuple[str, ...] = (
     "situation",
     "situation_ambiguous",
     "situation_basis",
+    "situation_utc",
     "own_role_colregs",
     "target_role_colregs",
     "target_estimated_restricted",
@@ -491,6 +495,7 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         situation=verdict.situation,
         situation_ambiguous=bool(held.ambiguous[0]),
         situation_basis=held.basis[0],
+        situation_utc=pair.situation_utc,
         role_colregs_a=verdict.role_colregs[0],
         role_colregs_b=verdict.role_colregs[1],
         nav_status_a=a.nav_status,
@@ -591,6 +596,7 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         situation=pair.situation,
         situation_ambiguous=pair.situation_ambiguous,
         situation_basis=pair.situation_basis,
+        situation_utc=pair.situation_utc,
         own_role_colregs=own_colregs,
         target_role_colregs=target_colregs,
         own_nav_status=own.nav_status,
