@@ -375,6 +375,8 @@ SERIES_VESSEL_FIELDS: tuple[str, ...] = (
     "sog_kn",
     "nav_status",
     "report_gap_s",
+    "nearest_report_s",
+    "gap_turn_deg",
 )
 SERIES_COLUMNS: tuple[str, ...] = (
     "step",
