@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+import shapely
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -25,6 +26,7 @@ from colregs9_cli.core.audit import (
     stand_on_turned_to_port_for_vessel_on_port,
 )
 from colregs9_cli.core.colregs import Role, Situation
+from colregs9_cli.core.pair_audit import over_land
 from colregs9_cli.core.rule9 import DecidingRule
 from colregs9_cli.errors import ParameterError
 
@@ -564,3 +566,34 @@ def test_sandiego_a_turn_that_may_have_come_before_the_closest_approach(sandiego
     )
     assert summary.mmsi_a == well_played
     assert summary.action_a == "insufficient-data"
+
+
+def test_a_least_separation_over_land_is_flagged() -> None:
+    land = shapely.box(100.0, 100.0, 200.0, 200.0)
+    window = pd.DataFrame(
+        {
+            "own_north_m": [0.0, 150.0],
+            "own_east_m": [0.0, 150.0],
+            "target_north_m": [0.0, 150.0],
+            "target_east_m": [50.0, 260.0],
+        }
+    )
+    assert over_land(land, window, 1) is True  # own ship drawn on the land
+    assert over_land(land, window, 0) is False
+    assert over_land(None, window, 1) is None  # no chart
+    assert over_land(land, window, None) is None  # no least separation
+    beyond = window.assign(own_north_m=np.nan)  # a pair beyond the run's frame
+    assert over_land(land, beyond, 1) is None
+
+
+def test_sandiego_a_pass_drawn_across_a_spit_is_flagged(sandiego_replay, dma_nmea_replay) -> None:
+    # SHELTER ISLAND reported at 00:00:12 and 00:02:12, either side of a spit; the straight
+    # line between crosses it, and there she "passed" SAILEBRATE at 55 m.
+    flagged = {
+        (p.summary.name_a, p.summary.name_b)
+        for p in sandiego_replay.pairs
+        if p.summary.min_separation_over_land
+    }
+    assert flagged == {("SHELTER ISLAND", "SAILEBRATE")}
+    # without a chart nothing is known of the land
+    assert all(p.summary.min_separation_over_land is None for p in dma_nmea_replay.pairs)

@@ -75,7 +75,7 @@ from .manoeuvrability import (
     assess_manoeuvrability,
     unplaced_assessment,
 )
-from .pair_audit import PREFIXES, PairAudit, audit_pair, hull_offsets
+from .pair_audit import PREFIXES, PairAudit, audit_pair, hull_offsets, over_land
 from .pair_model import PairEvaluation, PairSteps, VesselAtTrigger, nav_status
 from .pair_search import EncounterParams
 from .passing import PassingParams, horizon_steps, passing
@@ -412,7 +412,12 @@ def evaluate_pair(
         for i, prefix in enumerate(PREFIXES)
     )
     bends = (in_channel[0].bend_deg, in_channel[1].bend_deg)
-    audit = audit_pair(window, seen, hulls, lengths_m, params.conduct, step_s, bends)
+    audit = dataclasses.replace(
+        audit_pair(window, seen, hulls, lengths_m, params.conduct, step_s, bends),
+        min_separation_over_land=over_land(
+            None if chart is None else chart.land, window, seen.cpa_row
+        ),
+    )
     meeting = meeting_along_a_channel(
         (in_channel[0], in_channel[1]),
         (float(series["own_cog_deg"].iloc[0]), float(series["target_cog_deg"].iloc[0])),

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+import shapely
 
 from .audit import INSUFFICIENT_CONDUCT, Conduct, ConductParams, conduct, observed_rows
 from .hull import HullOffsets, least_hull_distance_geodetic_m, offsets_from_ais
@@ -39,6 +40,9 @@ class PairAudit:
     min_separation_report_gap_s: float | None = None
     min_separation_at_fixes_m: float | None = None
     min_separation_interpolated: bool | None = None
+    # Either vessel's position at the least separation on the chart's land: a track drawn
+    # across land between two reports (None: no chart, or no position in the chart's frame).
+    min_separation_over_land: bool | None = None
     # Each vessel's reports over the passing (None: no row).
     report_gaps: tuple[ReportGaps | None, ReportGaps | None] = (None, None)
 
@@ -106,6 +110,20 @@ def least_hull_separation_m(
         offsets[1],
     )
     return float(np.nanmin(distance)) if np.isfinite(distance).any() else None
+
+
+def over_land(land: Any, window: pd.DataFrame, row: int | None) -> bool | None:
+    """Whether either vessel's position at ``row`` of ``window`` (the least separation) lies
+    on ``land`` (the chart's land, in the frame of the window's ``north_m``/``east_m``):
+    San Diego's SHELTER ISLAND, drawn straight across a spit between reports 120 s apart,
+    "passed" SAILEBRATE at 55 m from dry land. None without land or a position."""
+    if land is None or row is None:
+        return None
+    north = window[[f"{p}north_m" for p in PREFIXES]].iloc[row].to_numpy(dtype=float)
+    east = window[[f"{p}east_m" for p in PREFIXES]].iloc[row].to_numpy(dtype=float)
+    if not (np.isfinite(north).all() and np.isfinite(east).all()):
+        return None
+    return bool(shapely.contains_xy(land, east, north).any())
 
 
 def audit_pair(

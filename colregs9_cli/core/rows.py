@@ -86,6 +86,7 @@ class PairSummary:
     min_separation_report_gap_s: float | None
     min_separation_at_fixes_m: float | None
     min_separation_interpolated: bool | None
+    min_separation_over_land: bool | None
     largest_report_gap_s_a: float | None
     largest_report_gap_s_b: float | None
     reports_sparse_a: bool | None
@@ -251,6 +252,7 @@ class EncounterSummary:
     min_separation_report_gap_s: float | None
     min_separation_at_fixes_m: float | None
     min_separation_interpolated: bool | None
+    min_separation_over_land: bool | None
     own_largest_report_gap_s: float | None
     target_largest_report_gap_s: float | None
     own_reports_sparse: bool | None
@@ -540,6 +542,7 @@ def pair_row(pair: PairEvaluation, seats: Sequence[int]) -> PairSummary:
         min_separation_report_gap_s=pair.audit.min_separation_report_gap_s,
         min_separation_at_fixes_m=pair.audit.min_separation_at_fixes_m,
         min_separation_interpolated=pair.audit.min_separation_interpolated,
+        min_separation_over_land=pair.audit.min_separation_over_land,
         largest_report_gap_s_a=_largest_gap_s(pair, 0),
         largest_report_gap_s_b=_largest_gap_s(pair, 1),
         reports_sparse_a=pair.audit.reports_sparse(0),
@@ -642,6 +645,7 @@ def seat_row(seat: Seat, pair: PairSummary) -> EncounterSummary:
         min_separation_report_gap_s=pair.min_separation_report_gap_s,
         min_separation_at_fixes_m=pair.min_separation_at_fixes_m,
         min_separation_interpolated=pair.min_separation_interpolated,
+        min_separation_over_land=pair.min_separation_over_land,
         own_largest_report_gap_s=_largest_gap_s(seat.pair, seat.mine((0, 1))[0]),
         target_largest_report_gap_s=_largest_gap_s(seat.pair, seat.mine((0, 1))[1]),
         own_reports_sparse=seat.pair.audit.reports_sparse(seat.mine((0, 1))[0]),
