@@ -127,7 +127,9 @@ IN_DOUBT_CASES = [
     # San Diego, TRADITION and CHAMPAGNE: 6.06 deg off one bow, 2.7 deg off the other
     (353.94, 2.72, HEAD_ON, GW, GW, SituationBasis.HEAD_ON_IN_DOUBT),
     (6.0 + EPS, 0.0, HEAD_ON, GW, GW, SituationBasis.HEAD_ON_IN_DOUBT),
-    (22.5 + EPS, 10.0, HEAD_ON, GW, GW, SituationBasis.HEAD_ON_IN_DOUBT),
+    # a move into the same-bow doubt is no move into the head-on sectors: no stacked doubt
+    (22.5 + EPS, 10.0, CROSSING, GW, SO, None),
+    (357.9, 19.0, CROSSING, SO, GW, None),  # San Diego: LETO 2.1 deg to port, 19 deg off hers
     # beyond the margin: a crossing
     (9.5, 350.5, CROSSING, GW, SO, None),
     (0.0, 112.5, OVERTAKING, GW, SO, SituationBasis.OVERTAKING_IN_DOUBT),

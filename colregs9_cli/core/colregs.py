@@ -33,8 +33,9 @@ seats swaps the roles and nothing else. In order of precedence:
 
 A situation is ``ambiguous`` when moving either bearing by ``ambiguity_margin_deg`` would change
 it or either role: it lies near a sector boundary, where the course noise of AIS can decide.
-The rules say how a vessel in doubt reads it: a crossing that such a move would make head-on
-is head-on (rule 14(c), "in any doubt ... assume that it does exist"; San Diego: TRADITION
+The rules say how a vessel in doubt reads it: a crossing that such a move would put in the
+head-on sectors (not merely in the doubt above) is head-on (rule 14(c), "in any doubt ...
+assume that it does exist"; San Diego: TRADITION
 6.06° off CHAMPAGNE's bow, CHAMPAGNE 2.7° off hers, courses 9° off reciprocal), with
 ``SituationBasis`` "head-on in doubt"; a crossing that such a move would make an overtaking
 by one vessel, and by her alone, is that overtaking (rule 13(c), "in any doubt ... assume
@@ -408,7 +409,10 @@ def classify(
                 | (moved.own_gives_way != result.own_gives_way)
                 | (moved.target_gives_way != result.target_gives_way)
             )
-            could_be_head_on |= moved.situation == 1
+            # only the head-on sectors themselves: a move into the wider same-bow doubt
+            # would stack one tolerance on another (a bearing 2° over the bow, moved across
+            # it, put a crossing 19° off the other's bow into the doubt)
+            could_be_head_on |= (moved.situation == 1) & (moved.basis == 0)
             could_overtake[0][...] |= (moved.situation == 0) & moved.own_gives_way
             could_overtake[1][...] |= (moved.situation == 0) & moved.target_gives_way
     ambiguous &= result.situation != 3

@@ -232,19 +232,21 @@ def _state(series: pd.DataFrame, prefix: str) -> dict[str, np.ndarray]:
     }
 
 
-def _situation_row(g_a: ColregsEvaluation, drawn: np.ndarray, last_row: int) -> int:
+def _situation_row(
+    g_a: ColregsEvaluation, drawn: np.ndarray, at_risk: np.ndarray, last_row: int
+) -> int:
     """The step the situation is read at: the trigger (row 0), unless a vessel's course
     there is drawn through a turn between two of her reports (``_course_drawn_across_a_turn``);
-    then the first step, while the pair still closes and no later than ``last_row`` (the
-    closest approach the trigger predicts), at which neither course is (San Diego: SHELTER
-    ISLAND reported 087° and, three minutes later, 126°; at the later report she and WHITE
-    NIGHTS met end on, where the 113° drawn between read a crossing). Row 0 when there is
-    none: the situation stays the trigger's, flagged ambiguous."""
+    then the first step, no later than ``last_row`` (the closest approach the trigger
+    predicts), at which neither course is and the trigger's conditions still hold
+    (``at_risk``: the pair closes to under ``cpa_req_m`` within ``tcpa_act_s``; San Diego:
+    SHELTER ISLAND reported 087° and, three minutes later, 126°; at the later report she and
+    WHITE NIGHTS met end on, where the 113° drawn between read a crossing). Row 0 when there
+    is none: the situation stays the trigger's, flagged ambiguous."""
     if not drawn[0]:
         return 0
-    seen = np.flatnonzero(
-        ~drawn[: last_row + 1] & (g_a.situation[: last_row + 1] != Situation.NONE)
-    )
+    readable = ~drawn & at_risk & (g_a.situation != Situation.NONE)
+    seen = np.flatnonzero(readable[: last_row + 1])
     return int(seen[0]) if len(seen) else 0
 
 
@@ -313,7 +315,14 @@ def _pair_steps(
         g_a, ambiguous=g_a.ambiguous | (drawn & (g_a.situation != Situation.NONE))
     )
     predicted_cpa_row = math.ceil(max(float(series["tcpa_s"].iloc[0]), 0.0) / step_s)
-    situation_row = _situation_row(g_a, drawn, predicted_cpa_row)
+    tcpa_s = series["tcpa_s"].to_numpy(dtype=float)
+    with np.errstate(invalid="ignore"):
+        at_risk = (
+            (tcpa_s >= 0.0)
+            & (tcpa_s <= params.encounters.tcpa_act_s)
+            & (series["cpa_m"].to_numpy(dtype=float) < params.encounters.cpa_req_m)
+        )
+    situation_row = _situation_row(g_a, drawn, at_risk, predicted_cpa_row)
     held = _held(g_a, meeting_in_channel, situation_row)
     situation = held.situation[0]
     roles = (held.own_role[0], held.target_role[0])
