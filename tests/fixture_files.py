@@ -18,3 +18,9 @@ MODELLED_CHART = DEMO_DATA / "aalborg_modelled.geojson"
 GREENHOPPER_QUERY = DEMO_DATA / "greenhopper.toml"
 SANDIEGO_AIS = ROOT / "fixtures" / "sandiego" / "marinecadastre_2022-01-03_sandiego_bay.csv"
 SANDIEGO_ENC = ROOT / "fixtures" / "sandiego" / "US5CA72M.000"
+
+
+def pair_summary(result, a: int, b: int):
+    """The summary of the pair of vessels ``a`` and ``b`` in a replay's result (either order)."""
+    (summary,) = (p.summary for p in result.pairs if {p.summary.mmsi_a, p.summary.mmsi_b} == {a, b})
+    return summary

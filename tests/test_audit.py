@@ -30,6 +30,8 @@ from colregs9_cli.core.pair_audit import over_land
 from colregs9_cli.core.rule9 import DecidingRule
 from colregs9_cli.errors import ParameterError
 
+from fixture_files import pair_summary
+
 PARAMS = ConductParams(
     course_change_deg=15.0,
     speed_change_frac=0.25,
@@ -429,26 +431,18 @@ def test_sandiego_a_situation_is_read_where_both_courses_are_reported(sandiego_r
     # SHELTER ISLAND reported 087.5 deg at 00:07:12 and 126.2 deg at 00:10:13; at the trigger
     # (00:09:13) the 113 deg drawn between read a crossing with WHITE NIGHTS. At her report
     # they met end on, and passed port to port.
-    def pair(a: int, b: int):
-        (found,) = (
-            p.summary
-            for p in sandiego_replay.pairs
-            if {p.summary.mmsi_a, p.summary.mmsi_b} == {a, b}
-        )
-        return found
-
-    shelter_island = pair(338187796, 338372419)
+    shelter_island = pair_summary(sandiego_replay, 338187796, 338372419)
     assert shelter_island.trigger_utc == pd.Timestamp("2022-01-03 00:09:13", tz="UTC")
     assert shelter_island.situation_utc == pd.Timestamp("2022-01-03 00:10:13", tz="UTC")
     assert shelter_island.situation == "head-on"
     assert shelter_island.passed_port_to_port == "true"
     # SAILEBRATE and ECHELON tack between reports up to the closest approach the trigger
     # predicts: read at the trigger, and flagged
-    tacking = pair(338254678, 368124990)
+    tacking = pair_summary(sandiego_replay, 338254678, 368124990)
     assert tacking.situation_utc == tacking.trigger_utc
     assert tacking.situation_ambiguous is True
     # a course reported at the trigger: read there
-    champagne_leto = pair(367412850, 368103590)
+    champagne_leto = pair_summary(sandiego_replay, 367412850, 368103590)
     assert champagne_leto.situation_utc == champagne_leto.trigger_utc
 
 
@@ -477,11 +471,7 @@ def test_dma_the_boat_that_turned_toward_the_ship_she_overtook_did_not_keep_clea
 ) -> None:
     # 211546840 overtaking 636092478: a port turn at 12:02:43 that took the predicted CPA
     # from 150 m to 26 m
-    (summary,) = (
-        p.summary
-        for p in dma_nmea_replay.pairs
-        if {p.summary.mmsi_a, p.summary.mmsi_b} == {211546840, 636092478}
-    )
+    summary = pair_summary(dma_nmea_replay, 211546840, 636092478)
     assert (summary.situation, summary.give_way_vessels) == ("overtaking", "211546840")
     assert summary.give_way_action == "port-turn"
     assert summary.give_way_action_as_rule_asks == "false"
@@ -513,11 +503,7 @@ def test_sandiego_a_channel_passing_port_to_port(sandiego_replay) -> None:
     # CHAMPAGNE and LETO meet in the San Diego Harbor Channel, each to her own starboard
     # side of its axis (+44 m and +21 m), and pass port to port at 93 m: no turn was needed.
     champagne, leto = 367412850, 368103590
-    (summary,) = (
-        p.summary
-        for p in sandiego_replay.pairs
-        if {p.summary.mmsi_a, p.summary.mmsi_b} == {champagne, leto}
-    )
+    summary = pair_summary(sandiego_replay, champagne, leto)
     assert summary.situation == "head-on"
     assert summary.passed_port_to_port == "true"
     assert summary.give_way_vessel_acted == "false"
@@ -559,11 +545,7 @@ def test_sandiego_a_turn_that_may_have_come_before_the_closest_approach(sandiego
     # WELL PLAYED reported 009.5 deg at 00:12:56 and 318.7 deg at 00:14:27; the least
     # separation with TRADITION was drawn at 00:14:06, between the two.
     well_played, tradition = 338307872, 338403914
-    (summary,) = (
-        p.summary
-        for p in sandiego_replay.pairs
-        if {p.summary.mmsi_a, p.summary.mmsi_b} == {well_played, tradition}
-    )
+    summary = pair_summary(sandiego_replay, well_played, tradition)
     assert summary.mmsi_a == well_played
     assert summary.action_a == "insufficient-data"
 

@@ -43,7 +43,7 @@ from colregs9_cli.geo import LocalFrame
 from colregs9_cli.jobs.replay_params import ReplayParams
 from colregs9_cli.units import MPS_PER_KNOT
 
-from fixture_files import NMEA, SANDIEGO_AIS
+from fixture_files import NMEA, SANDIEGO_AIS, pair_summary
 
 FRAME = LocalFrame(56.0, 12.6)
 STEP0 = 1_700_000_000  # the grid step of a hand-built series' first row (1 s steps)
@@ -652,20 +652,12 @@ def test_under_way_from_finds_where_both_make_way_for_the_rest_span() -> None:
 def test_dma_the_helsingor_ferries_are_judged_when_both_are_under_way(dma_nmea_replay) -> None:
     # 219622000 lay at her berth at the trigger (12:00:39) and left it at about 12:00:45; at
     # 12:02:26-34 both ferries made 9-10 kn 153-175 m apart: judged from when both made way.
-    (summary,) = (
-        p.summary
-        for p in dma_nmea_replay.pairs
-        if {p.summary.mmsi_a, p.summary.mmsi_b} == {219230000, 219622000}
-    )
+    summary = pair_summary(dma_nmea_replay, 219230000, 219622000)
     assert summary.interaction == "encounter"
     assert summary.interaction_basis.startswith("judged from 12:01:09, both under way")
     assert summary.trigger_utc == pd.Timestamp("2013-11-12 12:01:09", tz="UTC")
     # 6.8 deg off one bow, 2.3 deg off the other: head-on in doubt (rule 14(c))
     assert (summary.situation, summary.situation_basis) == ("head-on", "head-on in doubt")
     # a pair that stays at rest keeps its kind: the moored pair at Svendborg
-    (moored,) = (
-        p.summary
-        for p in dma_nmea_replay.pairs
-        if {p.summary.mmsi_a, p.summary.mmsi_b} == {265518160, 265548350}
-    )
+    moored = pair_summary(dma_nmea_replay, 265518160, 265548350)
     assert moored.interaction == "not-making-way"

@@ -42,6 +42,7 @@ from .pair_search import (
     candidate_runs,
     cpa_tcpa_vectors,
     join_runs,
+    trigger_mask,
 )
 from .passing import horizon_steps, passing
 from .tracks import STATE_COLUMNS, Tracks
@@ -461,7 +462,7 @@ def encounter_series(
 
     Columns: ``step``, ``timestamp``, ``own_<c>`` and ``target_<c>`` for each ``c`` in
     ``SERIES_VESSEL_COLUMNS``, then ``rel_north_m``, ``rel_east_m`` (target minus own),
-    ``range_m``, ``cpa_m``, ``tcpa_s``.
+    ``range_m``, ``cpa_m``, ``tcpa_s``, ``rel_speed_mps``.
     """
     first = encounter.start_step if from_step is None else from_step
     last = encounter.end_step if to_step is None else to_step
@@ -491,4 +492,12 @@ def encounter_series(
     series["range_m"] = range_m
     series["cpa_m"] = cpa_m
     series["tcpa_s"] = tcpa_s
+    series["rel_speed_mps"] = np.linalg.norm(rel_velocity, axis=-1)
     return series.reset_index(drop=True)
+
+
+def series_fires(series: pd.DataFrame, params: EncounterParams) -> NDArray[np.bool_]:
+    """The rows of an ``encounter_series`` at which the trigger holds, as the pair search
+    tests it (``pair_search.trigger_mask``)."""
+    with np.errstate(invalid="ignore"):
+        return trigger_mask(series["cpa_m"], series["tcpa_s"], series["rel_speed_mps"], params)

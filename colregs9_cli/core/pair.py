@@ -56,7 +56,7 @@ from .colregs import (
     evaluate_colregs,
 )
 from .confinement import DraughtOnChart
-from .encounters import Encounter, encounter_series
+from .encounters import Encounter, encounter_series, series_fires
 from .interactions import (
     Interaction,
     InteractionKind,
@@ -239,7 +239,7 @@ def _situation_row(
     there is drawn through a turn between two of her reports (``_course_drawn_across_a_turn``);
     then the first step, no later than ``last_row`` (the closest approach the trigger
     predicts), at which neither course is and the trigger's conditions still hold
-    (``at_risk``: the pair closes to under ``cpa_req_m`` within ``tcpa_act_s``; San Diego:
+    (``at_risk``: ``encounters.series_fires``; San Diego:
     SHELTER ISLAND reported 087° and, three minutes later, 126°; at the later report she and
     WHITE NIGHTS met end on, where the 113° drawn between read a crossing). Row 0 when there
     is none: the situation stays the trigger's, flagged ambiguous."""
@@ -315,13 +315,7 @@ def _pair_steps(
         g_a, ambiguous=g_a.ambiguous | (drawn & (g_a.situation != Situation.NONE))
     )
     predicted_cpa_row = math.ceil(max(float(series["tcpa_s"].iloc[0]), 0.0) / step_s)
-    tcpa_s = series["tcpa_s"].to_numpy(dtype=float)
-    with np.errstate(invalid="ignore"):
-        at_risk = (
-            (tcpa_s >= 0.0)
-            & (tcpa_s <= params.encounters.tcpa_act_s)
-            & (series["cpa_m"].to_numpy(dtype=float) < params.encounters.cpa_req_m)
-        )
+    at_risk = series_fires(series, params.encounters)
     situation_row = _situation_row(g_a, drawn, at_risk, predicted_cpa_row)
     held = _held(g_a, meeting_in_channel, situation_row)
     situation = held.situation[0]
@@ -492,17 +486,8 @@ def _judged_trigger(
         return pair.trigger_step, interaction
     first, held = under_way
     seen = passing(window["range_m"].to_numpy(), params.passing)
-    tcpa_s = window["tcpa_s"].to_numpy(dtype=float)
-    cpa_m = window["cpa_m"].to_numpy(dtype=float)
     rows = np.arange(len(window))
-    with np.errstate(invalid="ignore"):
-        fires = (
-            (rows >= held)
-            & (rows <= seen.end_row)
-            & (tcpa_s >= 0.0)
-            & (tcpa_s <= params.encounters.tcpa_act_s)
-            & (cpa_m < params.encounters.cpa_req_m)
-        )
+    fires = (rows >= held) & (rows <= seen.end_row) & series_fires(window, params.encounters)
     if not fires.any():
         return pair.trigger_step, interaction
     row = int(np.flatnonzero(fires)[0])
@@ -512,7 +497,7 @@ def _judged_trigger(
         facts,
         params.interactions,
         tracks.step_s,
-        float(tcpa_s[row]),
+        float(window["tcpa_s"].iloc[row]),
     )
     if later.kind is InteractionKind.NOT_MAKING_WAY:
         return pair.trigger_step, interaction
