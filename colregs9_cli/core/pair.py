@@ -356,6 +356,7 @@ def _pair_steps(
         g_a=g_a,
         held=held,
         situation_row=situation_row,
+        course_drawn=drawn,
         verdicts=verdicts,
         estimates=estimates,
         assessed_row=assessed_row,

@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
 from .ais_claims import NavStatusBelief
 from .audit import (
@@ -27,7 +28,6 @@ from .audit import (
     Fact,
     action_as_rule_asks,
     all_of,
-    course_drawn_through_a_turn,
     passed_port_to_port,
     stand_on_turned_to_port_for_vessel_on_port,
 )
@@ -84,6 +84,7 @@ class PairSteps:
     g_a: ColregsEvaluation
     held: ColregsEvaluation  # the situation read at ``situation_row``, repeated
     situation_row: int  # the trigger (0), or the first step with both courses reported
+    course_drawn: NDArray[np.bool_]  # either course drawn through a turn (pair.py), per step
     verdicts: list[PairVerdict]
     estimates: tuple[list[Restriction], list[Restriction]]
     assessed_row: tuple[list[int], list[int]]
@@ -212,14 +213,9 @@ class PairEvaluation:
         if not self.audit.covers_cpa or self.audit.cpa_utc is None:
             return Fact.INSUFFICIENT
         row = int(np.flatnonzero((times == self.audit.cpa_utc).to_numpy())[0])
-        there = self.steps.series.iloc[[row]]
-        params = self.conduct_params
-        judged = all(
-            float(there[f"{prefix}sog_kn"].iloc[0]) >= params.course_judged_above_kn
-            and not course_drawn_through_a_turn(
-                there[f"{prefix}report_gap_s"], there[f"{prefix}gap_turn_deg"], params
-            )[0]
-            for prefix in PREFIXES
+        speeds_kn = self.steps.series[[f"{p}sog_kn" for p in PREFIXES]].iloc[row]
+        judged = not self.steps.course_drawn[row] and bool(
+            (speeds_kn >= self.conduct_params.course_judged_above_kn).all()
         )
         return passed_port_to_port(
             situation,
