@@ -296,9 +296,7 @@ def under_way_from(
     in the same passing: a ferry leaving her berth (DMA: 219622000 at Helsingør, at her
     berth at the trigger, 12:00:39, away at 12:00:45, at 9-10 kn 155 m from the other ferry
     at 12:02:30). None when they never do so for that long."""
-    known = np.ones(len(series), dtype=bool)
-    for column in ("own_lat_deg", "own_lon_deg", "target_lat_deg", "target_lon_deg"):
-        known &= np.isfinite(series[column].to_numpy(dtype=float))
+    known = _positions_known(series)
     steps = series["step"].to_numpy(dtype=np.int64)
     consecutive = np.r_[True, np.diff(steps) == 1]
     usable = known & np.logical_and.accumulate(consecutive)
@@ -306,7 +304,7 @@ def under_way_from(
     if len(rows) < 2 or rows[0] != 0:
         return None
     part = series.iloc[: rows[-1] + 1]
-    span = max(1, round(params.speed_span_s / step_s / 2.0))
+    span = _half_span_steps(params, step_s)
     speeds = [
         _vessel(part, prefix, fact, seat, span, step_s).speed_kn
         for prefix, fact, seat in zip(("own_", "target_"), facts, "ab", strict=True)
@@ -337,9 +335,7 @@ def _window(
     if not 0 <= trigger_row < len(series):
         return None
     steps = series["step"].to_numpy(dtype=np.int64)
-    known = np.ones(len(series), dtype=bool)
-    for column in ("own_lat_deg", "own_lon_deg", "target_lat_deg", "target_lon_deg"):
-        known &= np.isfinite(series[column].to_numpy(dtype=float))
+    known = _positions_known(series)
     if not known[trigger_row]:
         return None
     trigger_step = int(steps[trigger_row])
@@ -356,7 +352,7 @@ def _window(
     if len(rows) < 2:
         return None
     part = series.iloc[rows]
-    span = max(1, round(params.speed_span_s / step_s / 2.0))
+    span = _half_span_steps(params, step_s)
     vessels = [
         _vessel(part, prefix, fact, seat, span, step_s)
         for prefix, fact, seat in zip(("own_", "target_"), facts, "ab", strict=True)
@@ -373,6 +369,19 @@ def _window(
         range_m=np.linalg.norm(b.position_m - a.position_m, axis=-1),
         rel_speed_kn=np.linalg.norm(rel_velocity, axis=-1) / MPS_PER_KNOT,
     )
+
+
+def _positions_known(series: pd.DataFrame) -> NDArray[np.bool_]:
+    """The rows with both vessels' positions."""
+    known = np.ones(len(series), dtype=bool)
+    for column in ("own_lat_deg", "own_lon_deg", "target_lat_deg", "target_lon_deg"):
+        known &= np.isfinite(series[column].to_numpy(dtype=float))
+    return known
+
+
+def _half_span_steps(params: InteractionParams, step_s: float) -> int:
+    """Steps either side of a row over which speeds over ground are measured."""
+    return max(1, round(params.speed_span_s / step_s / 2.0))
 
 
 def _vessel(
